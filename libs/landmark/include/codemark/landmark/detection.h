@@ -1,0 +1,44 @@
+#pragma once
+/** \file detection.h
+ * Plain data that crosses libraries (ARCHITECTURE.md): what the detector
+ * reports for one landmark. Defined here so the MRPT plugin can carry it
+ * without depending on the detector.
+ */
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+
+namespace codemark
+{
+/** How trustworthy one detection is. */
+struct DetectionQuality
+{
+	/** RMS distance of the edge points to the fitted line, per side in the
+	 * order top, right, bottom, left [px]. */
+	std::array<double, 4> line_rms_px{{0, 0, 0, 0}};
+	/** Number of edge points that supported each side's line fit. */
+	std::array<int, 4> line_support{{0, 0, 0, 0}};
+	/** Smallest margin between a code cell's mean intensity and the
+	 * black/green decision threshold, over the nine cells [grey levels,
+	 * 0..255]. Larger is safer. */
+	double code_margin = 0;
+	/** Area of the reference square in the image [px^2]. */
+	double area_px = 0;
+	/** Standard deviation of each corner coordinate estimated from the line
+	 * fits [px]; 0 when not estimated. */
+	double corner_sigma_px = 0;
+};
+
+/** One detected landmark. */
+struct Detection
+{
+	int id = -1;  //!< 0..255
+	/** The four reference points (inner frame corners) in raw (distorted)
+	 * pixel coordinates of the image, sub-pixel, pixel (0,0) at the centre of
+	 * the top-left pixel; order top-left, top-right, bottom-right, bottom-left
+	 * as they appear in the image. */
+	std::array<Eigen::Vector2d, 4> corners;
+	DetectionQuality quality;
+};
+
+}  // namespace codemark

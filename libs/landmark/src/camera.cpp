@@ -1,0 +1,301 @@
+#include <codemark/landmark/camera.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/containers/yaml.h>
+
+#include <Eigen/Dense>
+#include <opencv2/core/persistence.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace codemark
+{
+namespace
+{
+mrpt::img::TCamera paperCamera()
+{
+	mrpt::img::TCamera c;
+	c.ncols = 640;
+	c.nrows = 480;
+	c.setIntrinsicParamsFromValues(800.0, 800.0, 319.5, 239.5);
+	c.distortion = mrpt::img::DistortionModel::none;
+	c.cameraName = "paper";
+	return c;
+}
+
+void validateCamera(const mrpt::img::TCamera& c, const std::string& path)
+{
+	const bool finite = std::isfinite(c.fx()) && std::isfinite(c.fy()) &&
+		std::isfinite(c.cx()) && std::isfinite(c.cy()) &&
+		std::all_of(c.dist.begin(), c.dist.end(), [](double d) { return std::isfinite(d); });
+	if (!finite) throw std::runtime_error(path + ": camera parameters must be finite numbers");
+	if (c.ncols == 0 || c.nrows == 0)
+		throw std::runtime_error(path + ": camera resolution must be positive");
+	if (!(c.fx() > 0) || !(c.fy() > 0))
+		throw std::runtime_error(path + ": camera focal lengths fx, fy must be > 0");
+	if (c.distortion == mrpt::img::DistortionModel::kannala_brandt)
+		throw std::runtime_error(
+			path + ": the kannala_brandt (fisheye) model is not supported; use plumb_bob");
+}
+
+void addWarning(std::vector<std::string>* warnings, const std::string& w)
+{
+	if (warnings) warnings->push_back(w);
+	else
+		std::cerr << "warning: " << w << "\n";
+}
+
+bool startsWithOpenCvYaml(const std::string& path)
+{
+	std::ifstream f(path);
+	std::string first;
+	std::getline(f, first);
+	std::stringstream all;
+	all << f.rdbuf();
+	return first.rfind("%YAML:", 0) == 0 ||
+		all.str().find("!!opencv-matrix") != std::string::npos;
+}
+
+mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
+{
+	cv::FileStorage fs(path, cv::FileStorage::READ);
+	if (!fs.isOpened()) throw std::runtime_error(path + ": cannot parse OpenCV YAML");
+	cv::Mat K, D;
+	fs["camera_matrix"] >> K;
+	fs["distortion_coefficients"] >> D;
+	int w = 0, h = 0;
+	fs["image_width"] >> w;
+	fs["image_height"] >> h;
+	if (K.rows != 3 || K.cols != 3)
+		throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
+	if (w <= 0 || h <= 0)
+		throw std::runtime_error(path + ": expected positive 'image_width' and 'image_height'");
+	K.convertTo(K, CV_64F);
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(w);
+	c.nrows = static_cast<uint32_t>(h);
+	c.setIntrinsicParamsFromValues(
+		K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2));
+	c.distortion = mrpt::img::DistortionModel::none;
+	if (!D.empty())
+	{
+		D.convertTo(D, CV_64F);
+		const int n = static_cast<int>(D.total());
+		if (n != 4 && n != 5 && n != 8)
+			throw std::runtime_error(
+				path + ": 'distortion_coefficients' must have 4, 5 or 8 entries");
+		c.distortion = mrpt::img::DistortionModel::plumb_bob;
+		for (int i = 0; i < n; ++i) c.dist[i] = D.at<double>(i);
+	}
+	return c;
+}
+
+mrpt::img::TCamera loadRosYaml(const std::string& path)
+{
+	mrpt::containers::yaml y;
+	try
+	{
+		y = mrpt::containers::yaml::FromFile(path);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(path + ": cannot parse YAML: " + e.what());
+	}
+	for (const char* key : {"image_width", "image_height", "camera_matrix"})
+		if (!y.has(key))
+			throw std::runtime_error(path + ": missing required key '" + std::string(key) + "'");
+	if (!y.has("camera_name")) y["camera_name"] = std::string("camera");
+	if (!y.has("distortion_coefficients"))
+	{
+		y["distortion_model"] = std::string("none");
+	}
+	try
+	{
+		return mrpt::img::TCamera::FromYAML(y);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(path + ": bad camera YAML: " + e.what());
+	}
+}
+
+mrpt::img::TCamera loadIni(
+	const std::string& path, const std::string& section, std::vector<std::string>* warnings)
+{
+	mrpt::config::CConfigFile cfg(path);
+	if (!cfg.sectionExists(section))
+		throw std::runtime_error(path + ": no [" + section + "] section");
+	// MRPT 2.5.8 silently drops 'dist' unless 'distortion_model' is given.
+	const std::string dist = cfg.read_string(section, "dist", "");
+	const std::string model = cfg.read_string(section, "distortion_model", "");
+	if (model.empty() && !dist.empty())
+	{
+		std::string digits = dist;
+		const bool nonzero = std::any_of(
+			digits.begin(), digits.end(), [](char ch) { return ch >= '1' && ch <= '9'; });
+		if (nonzero)
+			addWarning(
+				warnings,
+				path + ": [" + section + "] has non-zero 'dist' but no 'distortion_model'; "
+				"MRPT ignores the distortion in that case, and so does codemark. "
+				"Add 'distortion_model = plumb_bob' to use it.");
+	}
+	mrpt::img::TCamera c;
+	try
+	{
+		c.loadFromConfigFile(section, cfg);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(
+			path + ": [" + section + "]: " + mrpt::exception_to_str(e));
+	}
+	return c;
+}
+
+std::string lowerExtension(const std::string& path)
+{
+	const auto dot = path.find_last_of('.');
+	if (dot == std::string::npos) return {};
+	std::string ext = path.substr(dot + 1);
+	std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) {
+		return static_cast<char>(std::tolower(ch));
+	});
+	return ext;
+}
+
+}  // namespace
+
+CameraModel::CameraModel() : params_(paperCamera()) {}
+
+CameraModel::CameraModel(const mrpt::img::TCamera& params) : params_(params)
+{
+	validateCamera(params_, "camera");
+}
+
+CameraModel CameraModel::load(
+	const std::string& path, std::vector<std::string>* warnings, const std::string& section)
+{
+	{
+		std::ifstream probe(path);
+		if (!probe) throw std::runtime_error(path + ": cannot open camera file");
+	}
+	const std::string ext = lowerExtension(path);
+	mrpt::img::TCamera c;
+	if (ext == "yaml" || ext == "yml")
+		c = startsWithOpenCvYaml(path) ? loadOpenCvYaml(path) : loadRosYaml(path);
+	else
+		c = loadIni(path, section, warnings);
+	validateCamera(c, path);
+	return CameraModel(c);
+}
+
+std::string findShareFile(const std::string& relative)
+{
+	std::vector<std::string> dirs;
+	if (const char* env = std::getenv("CODEMARK_SHARE_DIR")) dirs.emplace_back(env);
+	dirs.emplace_back(CODEMARK_SOURCE_SHARE_DIR);
+	dirs.emplace_back(CODEMARK_INSTALL_SHARE_DIR);
+	for (const auto& d : dirs)
+	{
+		const std::string p = d + "/" + relative;
+		if (std::ifstream(p).good()) return p;
+	}
+	return {};
+}
+
+CameraModel CameraModel::paperDefault()
+{
+	const std::string p = findShareFile("camera-paper.ini");
+	if (p.empty()) return CameraModel();
+	return load(p);
+}
+
+bool CameraModel::hasDistortion() const
+{
+	if (params_.distortion != mrpt::img::DistortionModel::plumb_bob) return false;
+	return std::any_of(params_.dist.begin(), params_.dist.end(), [](double d) { return d != 0; });
+}
+
+Eigen::Vector2d CameraModel::distortNormalized(const Eigen::Vector2d& xn) const
+{
+	double x = xn.x(), y = xn.y();
+	if (hasDistortion())
+	{
+		// OpenCV's rational plumb_bob model (k1 k2 p1 p2 k3 k4 k5 k6), written
+		// out because it is called per sample by the renderer, where
+		// cv::projectPoints would allocate per call.
+		const auto& d = params_.dist;
+		const double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
+		const double radial =
+			(1 + d[0] * r2 + d[1] * r4 + d[4] * r6) / (1 + d[5] * r2 + d[6] * r4 + d[7] * r6);
+		const double xd = x * radial + 2 * d[2] * x * y + d[3] * (r2 + 2 * x * x);
+		const double yd = y * radial + d[2] * (r2 + 2 * y * y) + 2 * d[3] * x * y;
+		x = xd;
+		y = yd;
+	}
+	return {fx() * x + cx(), fy() * y + cy()};
+}
+
+std::optional<Eigen::Vector2d> CameraModel::project(const Eigen::Vector3d& p) const
+{
+	if (!(p.z() > 0)) return std::nullopt;
+	return distortNormalized({p.x() / p.z(), p.y() / p.z()});
+}
+
+Eigen::Vector2d CameraModel::undistortToNormalized(const Eigen::Vector2d& raw) const
+{
+	const Eigen::Vector2d xd((raw.x() - cx()) / fx(), (raw.y() - cy()) / fy());
+	if (!hasDistortion()) return xd;
+	// Fixed-point iteration followed by Gauss-Newton polishing on the forward
+	// model: OpenCV's undistortPoints stops at a fixed iteration count, which
+	// leaves up to 1e-3 px at the image corners for strong distortion.
+	Eigen::Vector2d x = xd;
+	const auto& d = params_.dist;
+	for (int it = 0; it < 20; ++it)
+	{
+		const double r2 = x.squaredNorm(), r4 = r2 * r2, r6 = r4 * r2;
+		const double icdist =
+			(1 + d[5] * r2 + d[6] * r4 + d[7] * r6) / (1 + d[0] * r2 + d[1] * r4 + d[4] * r6);
+		const double dx = 2 * d[2] * x.x() * x.y() + d[3] * (r2 + 2 * x.x() * x.x());
+		const double dy = d[2] * (r2 + 2 * x.y() * x.y()) + 2 * d[3] * x.x() * x.y();
+		x = {(xd.x() - dx) * icdist, (xd.y() - dy) * icdist};
+	}
+	for (int it = 0; it < 5; ++it)
+	{
+		const auto f = [&](const Eigen::Vector2d& q) {
+			const Eigen::Vector2d px = distortNormalized(q);
+			return Eigen::Vector2d((px.x() - cx()) / fx(), (px.y() - cy()) / fy());
+		};
+		const Eigen::Vector2d r = f(x) - xd;
+		if (r.norm() < 1e-14) break;
+		const double h = 1e-7;
+		Eigen::Matrix2d J;
+		J.col(0) = (f(x + Eigen::Vector2d(h, 0)) - f(x - Eigen::Vector2d(h, 0))) / (2 * h);
+		J.col(1) = (f(x + Eigen::Vector2d(0, h)) - f(x - Eigen::Vector2d(0, h))) / (2 * h);
+		x -= J.fullPivLu().solve(r);
+	}
+	return x;
+}
+
+Eigen::Vector2d CameraModel::undistortPixel(const Eigen::Vector2d& raw) const
+{
+	if (!hasDistortion()) return raw;
+	const Eigen::Vector2d xn = undistortToNormalized(raw);
+	return {fx() * xn.x() + cx(), fy() * xn.y() + cy()};
+}
+
+std::string CameraModel::toIniText(const std::string& section) const
+{
+	mrpt::config::CConfigFileMemory cfg;
+	params_.saveToConfigFile(section, cfg);
+	return cfg.getContent();
+}
+
+}  // namespace codemark

@@ -1,0 +1,115 @@
+#pragma once
+/** \file render.h
+ * The test renderer: landmarks of a map seen by a camera, with exact
+ * perspective and exact ground truth (corners, visibility, L, the camera's
+ * pose in each landmark frame). Deterministic for a seed.
+ */
+#include <codemark/landmark/camera.h>
+#include <codemark/landmark/map.h>
+#include <codemark/landmark/truth.h>
+#include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <opencv2/core.hpp>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace codemark::sim
+{
+/** What is behind the landmarks. */
+enum class Background
+{
+	Flat,  //!< uniform grey
+	Textured,  //!< smooth random texture (a wall)
+	Cluttered  //!< texture plus distractors: green shapes, black rectangles, posters
+};
+
+/** Renderer settings. Every effect is off at its default except a flat
+ * background, so that a default render is exact. */
+struct RenderOptions : public mrpt::config::CLoadableOptions
+{
+	Background background = Background::Flat;
+	double background_grey = 128;  //!< Flat background level [0..255]
+	int distractors = 0;  //!< number of distractor shapes with Cluttered
+
+	/** Colours at gain 1, BGR [0..255]. Black is printed black, not 0. */
+	cv::Scalar black_bgr{25, 25, 25};
+	cv::Scalar white_bgr{235, 235, 235};
+	cv::Scalar green_bgr{0, 255, 0};  //!< fluorescent green: sRGB #00FF00
+
+	double gain = 1.0;  //!< illumination gain (multiplies all intensities)
+	double gradient = 0.0;  //!< relative gain change across the image (0.5: +-25% from the centre)
+	double gradient_angle_rad = 0.0;  //!< direction of the gradient in the image
+
+	double noise_sigma = 0.0;  //!< Gaussian pixel noise [grey levels]
+	double blur_sigma_px = 0.0;  //!< Gaussian blur [px]
+	double motion_blur_px = 0.0;  //!< length of linear motion blur [px]
+	double motion_blur_angle_rad = 0.0;  //!< its direction in the image
+	int jpeg_quality = 0;  //!< 0 = no JPEG round trip, else 1..100
+
+	/** Fraction [0..1] of each landmark's reference square to hide behind an
+	 * occluder (a grey bar over one side); 0 = none. */
+	double occlusion = 0.0;
+
+	void loadFromConfigFile(
+		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+	void saveToConfigFile(
+		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+};
+
+/** What to render. */
+struct Scene
+{
+	LandmarkMap map;
+	CameraModel camera;
+	/** Optical frame of the camera in the world (MRPT camera convention:
+	 * z along the optical axis, x right, y down). */
+	mrpt::poses::CPose3D world_T_camera;
+};
+
+/** Exact ground truth of one landmark of the map. */
+struct LandmarkTruth
+{
+	int id = -1;
+	/** Reference points (inner frame corners) in raw (distorted) pixels, in
+	 * the landmark's own order TL, TR, BR, BL as seen from the front (the
+	 * order as they appear in the image for a camera with little roll). */
+	std::array<Eigen::Vector2d, 4> corners_px;
+	/** The same corners undistorted (ideal pixels, same fx, fy, cx, cy). */
+	std::array<Eigen::Vector2d, 4> corners_ideal_px;
+	/** All of the landmark's outer frame is in front of the camera, inside
+	 * the image, and seen from the front side. */
+	bool fully_visible = false;
+	bool in_front = false;  //!< the landmark centre is in front of the camera
+	bool facing = false;  //!< the camera is on the printed side
+	double occluded_fraction = 0;  //!< as rendered
+	double area_px = 0;  //!< area of the reference square in the image [px^2]
+	Eigen::Vector4d P = Eigen::Vector4d::Zero();  //!< exact primary measurement
+	SightingTruth sighting;  //!< L and the camera's planar pose in frame L
+	mrpt::poses::CPose3D landmark_T_camera;  //!< exact 6-DoF pose
+};
+
+/** One rendered image. */
+struct Render
+{
+	cv::Mat image;  //!< CV_8UC3, BGR, camera resolution
+	std::vector<LandmarkTruth> truth;  //!< one per map landmark, map order
+};
+
+/** Renders \a scene. Deterministic for a given seed. */
+Render render(const Scene& scene, const RenderOptions& options, uint64_t seed);
+
+/** A level camera (optical axis horizontal, no roll) at distance
+ * \a distance_m from \a landmark's centre, seen at \a view_angle_rad between
+ * the line of sight and the landmark's outward normal (counter-clockwise
+ * positive, seen from above), at \a height_m above the landmark centre,
+ * turned so that the landmark centre appears \a bearing_rad left of the
+ * optical axis (phi1). Returns world_T_camera (optical frame). */
+mrpt::poses::CPose3D levelCameraLookingAt(
+	const MapLandmark& landmark, double distance_m, double view_angle_rad,
+	double height_m = 0.0, double bearing_rad = 0.0);
+
+}  // namespace codemark::sim
