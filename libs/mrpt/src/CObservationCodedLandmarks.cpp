@@ -1,0 +1,183 @@
+#include <codemark/mrpt/CObservationCodedLandmarks.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <iomanip>
+
+IMPLEMENTS_SERIALIZABLE(CObservationCodedLandmarks, mrpt::obs::CObservation, codemark)
+
+namespace codemark
+{
+namespace
+{
+template <class M>
+void writeMatrix(mrpt::serialization::CArchive& out, const M& m)
+{
+	for (int r = 0; r < m.rows(); ++r)
+		for (int c = 0; c < m.cols(); ++c) out << m(r, c);
+}
+template <class M>
+void readMatrix(mrpt::serialization::CArchive& in, M& m)
+{
+	for (int r = 0; r < m.rows(); ++r)
+		for (int c = 0; c < m.cols(); ++c) in >> m(r, c);
+}
+
+double deg(double rad) { return rad * 180.0 / M_PI; }
+double sd(double var) { return var > 0 ? std::sqrt(var) : 0.0; }
+}  // namespace
+
+uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 0; }
+
+void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
+{
+	out << timestamp << sensorLabel << cameraPose << camera;
+	out.WriteAs<uint32_t>(sightings.size());
+	for (const auto& s : sightings)
+	{
+		out << s.id;
+		for (const auto& c : s.corners) out << c.x() << c.y();
+		writeMatrix(out, s.P);
+		writeMatrix(out, s.C_P);
+		writeMatrix(out, s.L);
+		writeMatrix(out, s.C_L);
+		writeMatrix(out, s.pose_in_landmark);
+		writeMatrix(out, s.C_R);
+		for (double v : s.quality.line_rms_px) out << v;
+		for (int v : s.quality.line_support) out.WriteAs<int32_t>(v);
+		out << s.quality.code_margin << s.quality.area_px << s.quality.corner_sigma_px;
+		out.WriteAs<uint8_t>(static_cast<uint8_t>(s.method));
+	}
+}
+
+void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
+{
+	switch (version)
+	{
+		case 0:
+		{
+			in >> timestamp >> sensorLabel >> cameraPose >> camera;
+			const auto n = in.ReadAs<uint32_t>();
+			if (n > kMaxSightings)
+				THROW_EXCEPTION_FMT(
+					"CObservationCodedLandmarks: corrupt data, %u sightings (max %u)",
+					static_cast<unsigned>(n), static_cast<unsigned>(kMaxSightings));
+			sightings.assign(n, TSighting());
+			for (auto& s : sightings)
+			{
+				in >> s.id;
+				if (s.id < 0 || s.id > 255)
+					THROW_EXCEPTION_FMT(
+						"CObservationCodedLandmarks: corrupt data, landmark ID %d", s.id);
+				for (auto& c : s.corners) in >> c.x() >> c.y();
+				readMatrix(in, s.P);
+				readMatrix(in, s.C_P);
+				readMatrix(in, s.L);
+				readMatrix(in, s.C_L);
+				readMatrix(in, s.pose_in_landmark);
+				readMatrix(in, s.C_R);
+				for (double& v : s.quality.line_rms_px) in >> v;
+				for (int& v : s.quality.line_support) v = in.ReadAs<int32_t>();
+				in >> s.quality.code_margin >> s.quality.area_px >> s.quality.corner_sigma_px;
+				const auto m = in.ReadAs<uint8_t>();
+				if (m > static_cast<uint8_t>(PoseMethod::General6Dof))
+					THROW_EXCEPTION_FMT(
+						"CObservationCodedLandmarks: corrupt data, pose method %u",
+						static_cast<unsigned>(m));
+				s.method = static_cast<PoseMethod>(m);
+			}
+		}
+		break;
+		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	}
+}
+
+void CObservationCodedLandmarks::getDescriptionAsText(std::ostream& o) const
+{
+	CObservation::getDescriptionAsText(o);
+	o << "Camera pose on the robot (optical frame): " << cameraPose << "\n";
+	o << "Camera: " << camera.ncols << "x" << camera.nrows << " px, fx=" << camera.fx()
+	  << " fy=" << camera.fy() << " cx=" << camera.cx() << " cy=" << camera.cy() << "\n";
+	o << "Coded landmarks seen: " << sightings.size() << "\n";
+	const auto old = o.flags();
+	o << std::fixed;
+	for (const auto& s : sightings)
+	{
+		o << "\n  ID " << s.id << "  ("
+		  << (s.method == PoseMethod::ClosedForm ? "closed form" : "general 6-DoF") << ")\n";
+		o << std::setprecision(3) << "    range l2    = " << s.L[0] << " m  +- "
+		  << sd(s.C_L(0, 0)) << " m\n";
+		o << std::setprecision(2) << "    bearing phi1 = " << deg(s.L[1]) << " deg  +- "
+		  << deg(sd(s.C_L(1, 1))) << " deg\n";
+		o << "    orientation phi2 = " << deg(s.L[2]) << " deg  +- " << deg(sd(s.C_L(2, 2)))
+		  << " deg\n";
+		o << std::setprecision(3) << "    camera in landmark frame: x = " << s.pose_in_landmark[0]
+		  << " m, y = " << s.pose_in_landmark[1] << " m, theta = " << std::setprecision(2)
+		  << deg(s.pose_in_landmark[2]) << " deg  (1-sigma " << std::setprecision(3)
+		  << sd(s.C_R(0, 0)) << ", " << sd(s.C_R(1, 1)) << " m, " << std::setprecision(2)
+		  << deg(sd(s.C_R(2, 2))) << " deg)\n";
+		o << std::setprecision(2) << "    corners [px]: ";
+		for (const auto& c : s.corners) o << "(" << c.x() << ", " << c.y() << ") ";
+		o << "\n    P = [" << s.P.transpose() << "] px, code margin " << s.quality.code_margin
+		  << ", area " << std::setprecision(0) << s.quality.area_px << " px^2\n";
+	}
+	o.flags(old);
+}
+
+mrpt::poses::CPose3D xForwardPoseOfCamera(const mrpt::poses::CPose3D& p)
+{
+	const auto R = p.getRotationMatrix();
+	const double heading = std::atan2(R(1, 2), R(0, 2));
+	return mrpt::poses::CPose3D(p.x(), p.y(), p.z(), heading, 0.0, 0.0);
+}
+
+mrpt::obs::CObservationBearingRange::Ptr CObservationCodedLandmarks::toBearingRange(
+	const std::string& label, float max_range_m) const
+{
+	auto br = mrpt::obs::CObservationBearingRange::Create();
+	br->timestamp = timestamp;
+	if (!label.empty()) br->sensorLabel = label;
+	else
+	{
+		const std::string suffix = "_LANDMARKS";
+		std::string base = sensorLabel;
+		if (base.size() >= suffix.size() &&
+			base.compare(base.size() - suffix.size(), suffix.size(), suffix) == 0)
+			base.erase(base.size() - suffix.size());
+		br->sensorLabel = base + "_BR";
+	}
+	br->sensorLocationOnRobot = xForwardPoseOfCamera(cameraPose);
+	if (camera.fx() > 0 && camera.fy() > 0)
+	{
+		br->fieldOfView_yaw = static_cast<float>(2 * std::atan(0.5 * camera.ncols / camera.fx()));
+		br->fieldOfView_pitch = static_cast<float>(2 * std::atan(0.5 * camera.nrows / camera.fy()));
+	}
+	br->minSensorDistance = 0;
+	br->maxSensorDistance = max_range_m;
+	br->validCovariances = true;
+	double max_var_r = 0, max_var_yaw = 0;
+	for (const auto& s : sightings)
+	{
+		mrpt::obs::CObservationBearingRange::TMeasurement m;
+		m.range = static_cast<float>(s.L[0]);
+		m.yaw = static_cast<float>(s.L[1]);
+		m.pitch = 0;
+		m.landmarkID = s.id;
+		m.covariance.setZero();
+		for (int r = 0; r < 2; ++r)
+			for (int c = 0; c < 2; ++c) m.covariance(r, c) = s.C_L(r, c);
+		// The camera measures no elevation: give pitch the bearing's variance
+		// so that the 3x3 block stays positive definite.
+		m.covariance(2, 2) = s.C_L(1, 1);
+		br->sensedData.push_back(m);
+		max_var_r = std::max(max_var_r, s.C_L(0, 0));
+		max_var_yaw = std::max(max_var_yaw, s.C_L(1, 1));
+	}
+	br->sensor_std_range = static_cast<float>(std::sqrt(max_var_r));
+	br->sensor_std_yaw = static_cast<float>(std::sqrt(max_var_yaw));
+	br->sensor_std_pitch = br->sensor_std_yaw;
+	return br;
+}
+
+}  // namespace codemark
