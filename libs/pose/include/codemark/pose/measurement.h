@@ -1,0 +1,101 @@
+#pragma once
+/** \file measurement.h
+ * The measurement of one sighted landmark (ARCHITECTURE.md: "Measurement
+ * {P, C_P, L, C_L, pose_in_landmark, C_R, method}"; landmark-spec.md
+ * section 4), its options, and measure(), the single entry point that runs
+ * either the paper's closed form or the general 6-DoF path.
+ */
+#include <codemark/landmark/camera.h>
+#include <codemark/landmark/geometry.h>
+#include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+
+namespace codemark::pose
+{
+/** Which computation turns the corners into L and the pose. */
+enum class PoseMethod
+{
+	/** The paper's closed form P -> L -> pose (section 2.3), first-order
+	 * covariances with analytic Jacobians. Assumes a level camera (optical
+	 * axis horizontal) and uses P only. */
+	ClosedForm,
+	/** Full 6-DoF pose from the four corners (planar PnP, both IPPE
+	 * solutions refined by Levenberg-Marquardt on the reprojection error),
+	 * reduced to the planar L and pose; any camera orientation, lens
+	 * distortion. */
+	General6Dof
+};
+
+/** "ClosedForm" / "General6Dof" (case-insensitive on read). */
+std::string toString(PoseMethod m);
+/** Throws std::invalid_argument naming the accepted values. */
+PoseMethod poseMethodFromString(const std::string& name);
+
+/** Default standard deviation of each component of P [px]. The spec's
+ * shipped default is to be calibrated from the detector's measured corner
+ * error (landmark-spec.md section 4); until that calibration exists this is
+ * the value the issue asks for (corners good to about 0.05 px, the accuracy
+ * targets of issue 4). The paper used 1 px. */
+constexpr double kDefaultSigmaPx = 0.05;
+
+/** Options of measure(). Loadable from an ini section. */
+struct PoseOptions : public mrpt::config::CLoadableOptions
+{
+	PoseMethod method = PoseMethod::ClosedForm;  //!< ini key `method` = ClosedForm | General6Dof
+	/** Standard deviation of each component of P = [x1 y1 x2 y2] [px]
+	 * (C_P = diag(s^2, s^2, s^2, s^2)). Each corner coordinate then has
+	 * sqrt(2) * sigma_px, which the general path uses. */
+	double sigma_px = kDefaultSigmaPx;
+	/** General path: Levenberg-Marquardt iterations of each refinement. */
+	int lm_max_iterations = 30;
+
+	/** Throws std::invalid_argument on a non-positive sigma or iteration count. */
+	void validate() const;
+	void loadFromConfigFile(
+		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+	void saveToConfigFile(
+		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+};
+
+/** One landmark measurement (landmark-spec.md section 4). */
+struct Measurement
+{
+	/** P = [x1 y1 x2 y2]: midpoints' x and half-lengths of the left and right
+	 * vertical inner edges, from the undistorted corners, in px of focal
+	 * length lambda = fx relative to the principal point. */
+	Eigen::Vector4d P = Eigen::Vector4d::Zero();
+	Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();  //!< covariance of P [px^2]
+	/** L = [l2 [m], phi1 [rad], phi2 [rad]] (spec section 4). */
+	Eigen::Vector3d L = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();  //!< covariance of L
+	/** The camera's planar pose in frame L: x, y [m] of the optical centre,
+	 * theta [rad] heading of the optical axis, wrapped to (-pi, pi]. */
+	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();  //!< covariance of pose_in_landmark
+	PoseMethod method = PoseMethod::ClosedForm;  //!< the path that produced it
+
+	/** General path only: the camera's optical frame in frame L (6-DoF). */
+	mrpt::poses::CPose3D landmark_T_camera;
+	/** General path only: RMS reprojection error of the chosen solution [px]. */
+	double reprojection_rms_px = 0;
+	/** General path only: RMS reprojection error of the other IPPE solution
+	 * over that of the chosen one (>= 1; large = unambiguous; infinity when
+	 * the chosen one is exact or there is one solution). */
+	double ambiguity_ratio = 0;
+};
+
+/** Measures one landmark from its four reference points.
+ * \param corners_raw_px raw (distorted) pixels, order TL, TR, BR, BL as seen
+ *        from the front (the Detection::corners order).
+ * \param camera intrinsics and distortion.
+ * \param geometry the landmark's sizes (scaled landmarks: LandmarkGeometry::scaled()).
+ * Throws std::invalid_argument on degenerate corners. */
+Measurement measure(
+	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
+	const LandmarkGeometry& geometry, const PoseOptions& options = PoseOptions());
+
+}  // namespace codemark::pose

@@ -1,0 +1,119 @@
+#include <codemark/landmark/truth.h>
+#include <codemark/pose/closed_form.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace codemark::pose
+{
+Eigen::Vector3d landmarkFromPrimary(
+	const Eigen::Vector4d& P, double lambda, double h, Eigen::Matrix<double, 3, 4>* J_P)
+{
+	const double x1 = P[0], y1 = P[1], x2 = P[2], y2 = P[3];
+	if (!(y1 > 0) || !(y2 > 0) || !(lambda > 0))
+	{
+		std::ostringstream s;
+		s << "landmarkFromPrimary: need y1, y2, lambda > 0, got y1=" << y1 << " y2=" << y2
+		  << " lambda=" << lambda;
+		throw std::invalid_argument(s.str());
+	}
+	// Paper eq. 1-3 (spec signs). Z_i = lambda h / y_i and X_i = x_i h / y_i
+	// locate each vertical edge's centre; the landmark centre is their
+	// midpoint, at lateral/depth ratio xm / lambda.
+	const double s = y1 + y2;
+	const double xm = (x1 * y2 + x2 * y1) / s;
+	const double r2 = lambda * lambda + xm * xm;
+	const double r = std::sqrt(r2);
+	const double k = 0.5 * h * (1.0 / y1 + 1.0 / y2);  // = h (y1 + y2) / (2 y1 y2)
+	const double N = lambda * (y2 - y1);
+	const double D = x2 * y1 - x1 * y2;
+	const Eigen::Vector3d L(k * r, -std::atan2(xm, lambda), std::atan2(N, D));
+
+	if (J_P)
+	{
+		// Derivatives of the intermediate quantities w.r.t. (x1, y1, x2, y2).
+		const Eigen::RowVector4d dxm(
+			y2 / s, y2 * (x2 - x1) / (s * s), y1 / s, y1 * (x1 - x2) / (s * s));
+		const Eigen::RowVector4d dk(0, -0.5 * h / (y1 * y1), 0, -0.5 * h / (y2 * y2));
+		const Eigen::RowVector4d dN(0, -lambda, 0, lambda);
+		const Eigen::RowVector4d dD(-y2, x2, y1, -x1);
+		// l2 = k r, r = sqrt(lambda^2 + xm^2)
+		J_P->row(0) = dk * r + (k * xm / r) * dxm;
+		// phi1 = -atan2(xm, lambda)
+		J_P->row(1) = (-lambda / r2) * dxm;
+		// phi2 = atan2(N, D)
+		J_P->row(2) = (D * dN - N * dD) / (N * N + D * D);
+	}
+	return L;
+}
+
+Eigen::Vector3d poseFromLandmark(const Eigen::Vector3d& L, Eigen::Matrix3d* J_L)
+{
+	// Paper eq. 12-14 in the spec's convention (landmark-spec.md section 4).
+	const double l2 = L[0], a = L[1] + L[2];
+	const double c = std::cos(a), sn = std::sin(a);
+	if (J_L)
+	{
+		*J_L << c, -l2 * sn, -l2 * sn,  //
+			sn, l2 * c, l2 * c,  //
+			0, 0, 1;
+	}
+	return {l2 * c, l2 * sn, wrapToPi(M_PI + L[2])};
+}
+
+Eigen::Matrix4d primaryCovariance(double sx, double sy)
+{
+	return Eigen::Vector4d(sx * sx, sy * sy, sx * sx, sy * sy).asDiagonal();
+}
+
+mrpt::poses::CPose2D cameraPlanarPose(const mrpt::poses::CPose3D& robot_T_camera)
+{
+	const auto R = robot_T_camera.getRotationMatrix();
+	// Optical axis (camera z) in the robot frame, projected on the floor.
+	return mrpt::poses::CPose2D(
+		robot_T_camera.x(), robot_T_camera.y(), std::atan2(R(1, 2), R(0, 2)));
+}
+
+mrpt::poses::CPose2D landmarkPlanarPose(const mrpt::poses::CPose3D& world_T_landmark)
+{
+	return mrpt::poses::CPose2D(world_T_landmark.x(), world_T_landmark.y(), world_T_landmark.yaw());
+}
+
+mrpt::poses::CPose2D robotPoseInWorld(
+	const Eigen::Vector3d& c, const Eigen::Matrix3d& C_R,
+	const mrpt::poses::CPose2D& world_T_landmark, const mrpt::poses::CPose2D& robot_T_camera,
+	Eigen::Matrix3d* C_world, Eigen::Matrix3d* J_out)
+{
+	using mrpt::poses::CPose2D;
+	const CPose2D world_T_camera = world_T_landmark + CPose2D(c[0], c[1], c[2]);
+	const CPose2D camera_T_robot = CPose2D() - robot_T_camera;  // inverse
+	const CPose2D world_T_robot = world_T_camera + camera_T_robot;
+	if (C_world || J_out)
+	{
+		// d(a (+) b)/db = rot(a.phi) (+ 1 for the angle);
+		// d(q (+) d)/dq = [1 0 -dx sin - dy cos; 0 1 dx cos - dy sin; 0 0 1].
+		const double ca = std::cos(world_T_landmark.phi()), sa = std::sin(world_T_landmark.phi());
+		Eigen::Matrix3d J1;
+		J1 << ca, -sa, 0, sa, ca, 0, 0, 0, 1;
+		const double q = world_T_camera.phi(), cq = std::cos(q), sq = std::sin(q);
+		const double dx = camera_T_robot.x(), dy = camera_T_robot.y();
+		Eigen::Matrix3d J2;
+		J2 << 1, 0, -dx * sq - dy * cq, 0, 1, dx * cq - dy * sq, 0, 0, 1;
+		const Eigen::Matrix3d J = J2 * J1;
+		if (J_out) *J_out = J;
+		if (C_world) *C_world = J * C_R * J.transpose();
+	}
+	return world_T_robot;
+}
+
+Eigen::Vector3d cameraInLandmark(
+	const mrpt::poses::CPose2D& world_T_robot, const mrpt::poses::CPose2D& world_T_landmark,
+	const mrpt::poses::CPose2D& robot_T_camera)
+{
+	const mrpt::poses::CPose2D c = (world_T_robot + robot_T_camera) - world_T_landmark;
+	return {c.x(), c.y(), wrapToPi(c.phi())};
+}
+
+}  // namespace codemark::pose

@@ -1,0 +1,261 @@
+// The paper's closed form against geometric truth, its Jacobians against
+// central differences, and the composition to the robot's world pose.
+#include <codemark/landmark/map.h>
+#include <codemark/landmark/primary.h>
+#include <codemark/landmark/truth.h>
+#include <codemark/pose/closed_form.h>
+#include <codemark/pose/measurement.h>
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "common.h"
+
+using namespace codemark;
+using namespace codemark::pose;
+using codemark::test::cameraAt;
+using codemark::test::projectCorners;
+using mrpt::poses::CPose2D;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+// Relative agreement of two matrices, element by element, against the
+// largest entry of the row (a row mixes px-scale and rad-scale derivatives).
+template <typename A, typename B>
+void expectJacobianNear(const A& analytic, const B& numeric, double rel, const std::string& what)
+{
+	for (int r = 0; r < analytic.rows(); ++r)
+	{
+		const double scale = std::max(analytic.row(r).cwiseAbs().maxCoeff(), 1e-300);
+		for (int c = 0; c < analytic.cols(); ++c)
+			EXPECT_NEAR(analytic(r, c), numeric(r, c), rel * scale)
+				<< what << " row " << r << " col " << c;
+	}
+}
+
+struct Config
+{
+	double d, angle, z, phi1, scale;
+};
+
+// Random level-camera configurations whose reference square is in view.
+std::vector<Config> randomConfigs(int n, uint32_t seed)
+{
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> d(0.4, 6.0), a(-1.3, 1.3), z(-0.5, 0.5),
+		p1(-0.3, 0.3), s(0.5, 2.0);
+	std::vector<Config> out;
+	for (int i = 0; i < n; ++i) out.push_back({d(rng), a(rng), z(rng), p1(rng), s(rng)});
+	// Exactly frontal (y1 = y2) and strongly oblique cases.
+	out.push_back({2.0, 0.0, 0.0, 0.0, 1.0});
+	out.push_back({1.0, 0.0, 0.3, 0.2, 1.0});
+	out.push_back({3.0, 1.4, 0.0, 0.0, 1.0});
+	out.push_back({1.5, -1.4, -0.2, -0.1, 1.0});
+	return out;
+}
+}  // namespace
+
+TEST(ClosedForm, MatchesGeometricTruth)
+{
+	const CameraModel cam;
+	for (const Config& c : randomConfigs(200, 1))
+	{
+		const LandmarkGeometry g = LandmarkGeometry::scaled(c.scale);
+		const CPose3D landmark_T_camera = cameraAt(c.d, c.angle, c.z, c.phi1);
+		const SightingTruth truth = sightingTruth(landmark_T_camera);
+		double lambda = 0;
+		const Eigen::Vector4d P = primaryMeasurement(projectCorners(landmark_T_camera, cam, g), cam, &lambda);
+		const Eigen::Vector3d L = landmarkFromPrimary(P, lambda, g.innerHalf());
+		EXPECT_NEAR(L[0], truth.L[0], 1e-9 * truth.L[0]) << "d " << c.d << " angle " << c.angle;
+		EXPECT_NEAR(L[1], truth.L[1], 1e-9);
+		EXPECT_NEAR(L[2], truth.L[2], 1e-9);
+		const Eigen::Vector3d pose = poseFromLandmark(L);
+		EXPECT_NEAR(pose[0], truth.pose_in_landmark[0], 1e-9 * c.d);
+		EXPECT_NEAR(pose[1], truth.pose_in_landmark[1], 1e-9 * c.d);
+		EXPECT_NEAR(wrapToPi(pose[2] - truth.pose_in_landmark[2]), 0.0, 1e-9);
+	}
+}
+
+TEST(ClosedForm, SignsOnSimpleCases)
+{
+	// Landmark left of the image centre: x1, x2 < 0, phi1 > 0.
+	const Eigen::Vector3d L = landmarkFromPrimary(Eigen::Vector4d(-100, 40, -60, 40), 800, 0.08);
+	EXPECT_GT(L[1], 0);
+	EXPECT_NEAR(L[2], 0, 1e-15);  // equal edges: seen squarely
+	// Right edge longer (closer): the camera sits on the landmark's -Y side
+	// (observer's left), its axis turned clockwise from the inward normal.
+	const Eigen::Vector3d L2 = landmarkFromPrimary(Eigen::Vector4d(-20, 40, 20, 42), 800, 0.08);
+	EXPECT_GT(L2[2], 0);
+	EXPECT_THROW(landmarkFromPrimary(Eigen::Vector4d(0, 0, 10, 10), 800, 0.08), std::invalid_argument);
+	EXPECT_THROW(landmarkFromPrimary(Eigen::Vector4d(0, 10, 10, -1), 800, 0.08), std::invalid_argument);
+}
+
+TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
+{
+	const CameraModel cam;
+	for (const Config& c : randomConfigs(100, 2))
+	{
+		const LandmarkGeometry g = LandmarkGeometry::scaled(c.scale);
+		double lambda = 0;
+		const Eigen::Vector4d P =
+			primaryMeasurement(projectCorners(cameraAt(c.d, c.angle, c.z, c.phi1), cam, g), cam, &lambda);
+		Eigen::Matrix<double, 3, 4> J;
+		landmarkFromPrimary(P, lambda, g.innerHalf(), &J);
+		Eigen::Matrix<double, 3, 4> Jn;
+		for (int k = 0; k < 4; ++k)
+		{
+			const double h = 1e-6 * std::max(1.0, std::abs(P[k]));
+			Eigen::Vector4d a = P, b = P;
+			a[k] += h;
+			b[k] -= h;
+			Jn.col(k) = (landmarkFromPrimary(a, lambda, g.innerHalf()) -
+						 landmarkFromPrimary(b, lambda, g.innerHalf())) /
+				(2 * h);
+		}
+		expectJacobianNear(J, Jn, 1e-6, "J_P");
+	}
+}
+
+TEST(ClosedForm, JacobianOfPoseMatchesCentralDifferences)
+{
+	for (const Config& c : randomConfigs(100, 3))
+	{
+		const Eigen::Vector3d L = sightingTruth(cameraAt(c.d, c.angle, c.z, c.phi1)).L;
+		Eigen::Matrix3d J;
+		poseFromLandmark(L, &J);
+		Eigen::Matrix3d Jn;
+		for (int k = 0; k < 3; ++k)
+		{
+			const double h = 1e-6;
+			Eigen::Vector3d a = L, b = L;
+			a[k] += h;
+			b[k] -= h;
+			Eigen::Vector3d d = poseFromLandmark(a) - poseFromLandmark(b);
+			d[2] = wrapToPi(d[2]);
+			Jn.col(k) = d / (2 * h);
+		}
+		expectJacobianNear(J, Jn, 1e-6, "J_L");
+	}
+}
+
+TEST(ClosedForm, CovariancePropagation)
+{
+	const Eigen::Matrix4d C_P = primaryCovariance(0.1, 0.2);
+	EXPECT_DOUBLE_EQ(C_P(0, 0), 0.01);
+	EXPECT_DOUBLE_EQ(C_P(1, 1), 0.04);
+	EXPECT_DOUBLE_EQ(C_P(3, 3), 0.04);
+	EXPECT_DOUBLE_EQ(C_P(0, 1), 0.0);
+	// measure() uses C_L = J_P C_P J_P^T and C_R = J_L C_L J_L^T.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	PoseOptions opt;
+	opt.sigma_px = 0.3;
+	const auto corners = projectCorners(cameraAt(2.0, 0.5, 0.1, 0.1), cam, g);
+	const Measurement m = measure(corners, cam, g, opt);
+	Eigen::Matrix<double, 3, 4> J_P;
+	Eigen::Matrix3d J_L;
+	landmarkFromPrimary(m.P, cam.fx(), g.innerHalf(), &J_P);
+	poseFromLandmark(m.L, &J_L);
+	const Eigen::Matrix3d C_L = J_P * primaryCovariance(0.3, 0.3) * J_P.transpose();
+	EXPECT_LT((m.C_L - C_L).norm(), 1e-12 * C_L.norm());
+	EXPECT_LT((m.C_R - J_L * C_L * J_L.transpose()).norm(), 1e-12 * m.C_R.norm());
+	// phi2 is the weak direction: larger than phi1's variance by orders.
+	EXPECT_GT(m.C_L(2, 2), 100 * m.C_L(1, 1));
+}
+
+TEST(Composition, RobotWorldPoseRecoveredExactly)
+{
+	const CameraModel cam;
+	std::mt19937 rng(4);
+	std::uniform_real_distribution<double> u(-1, 1);
+	for (int i = 0; i < 50; ++i)
+	{
+		// A landmark on a wall somewhere, scaled.
+		MapLandmark lm;
+		lm.x_m = 3 * u(rng);
+		lm.y_m = 3 * u(rng);
+		lm.z_m = 0.8 + 0.3 * u(rng);
+		lm.yaw_rad = M_PI * u(rng);
+		lm.scale = 1.0 + 0.5 * u(rng);
+		// A camera mounted with offset, height and yaw (optical axis level).
+		const double mount_yaw = 0.8 * u(rng);
+		const CPose3D robot_T_camera =
+			CPose3D(0.2 * u(rng), 0.1 * u(rng), 0.6 + 0.3 * u(rng), mount_yaw, 0, 0) +
+			CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		// The robot placed so that the camera sees the landmark from the front.
+		const CPose3D landmark_T_camera = cameraAt(1 + 2 * std::abs(u(rng)), 0.8 * u(rng),
+			robot_T_camera.z() - lm.z_m, 0.2 * u(rng));
+		const CPose3D world_T_camera = lm.world_T_landmark() + landmark_T_camera;
+		const CPose3D world_T_robot3 = world_T_camera + (-robot_T_camera);
+		ASSERT_NEAR(world_T_robot3.z(), 0, 1e-9);
+		ASSERT_NEAR(world_T_robot3.pitch(), 0, 1e-9);
+		ASSERT_NEAR(world_T_robot3.roll(), 0, 1e-9);
+
+		const Measurement m =
+			measure(projectCorners(landmark_T_camera, cam, lm.geometry()), cam, lm.geometry());
+		Eigen::Matrix3d C_world, J;
+		const CPose2D robot = robotPoseInWorld(m.pose_in_landmark, m.C_R,
+			landmarkPlanarPose(lm.world_T_landmark()), cameraPlanarPose(robot_T_camera), &C_world, &J);
+		EXPECT_NEAR(robot.x(), world_T_robot3.x(), 1e-8);
+		EXPECT_NEAR(robot.y(), world_T_robot3.y(), 1e-8);
+		EXPECT_NEAR(wrapToPi(robot.phi() - world_T_robot3.yaw()), 0, 1e-9);
+		// The inverse mapping gives back the camera's pose in L.
+		const Eigen::Vector3d c = cameraInLandmark(robot, landmarkPlanarPose(lm.world_T_landmark()),
+			cameraPlanarPose(robot_T_camera));
+		EXPECT_LT((c.head<2>() - m.pose_in_landmark.head<2>()).norm(), 1e-8);
+		EXPECT_NEAR(wrapToPi(c[2] - m.pose_in_landmark[2]), 0, 1e-9);
+
+		// The composition's Jacobian against central differences.
+		Eigen::Matrix3d Jn;
+		for (int k = 0; k < 3; ++k)
+		{
+			const double h = 1e-6;
+			Eigen::Vector3d a = m.pose_in_landmark, b = a;
+			a[k] += h;
+			b[k] -= h;
+			const CPose2D ra = robotPoseInWorld(a, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+				cameraPlanarPose(robot_T_camera));
+			const CPose2D rb = robotPoseInWorld(b, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+				cameraPlanarPose(robot_T_camera));
+			Jn.col(k) << (ra.x() - rb.x()) / (2 * h), (ra.y() - rb.y()) / (2 * h),
+				wrapToPi(ra.phi() - rb.phi()) / (2 * h);
+		}
+		EXPECT_LT((J - Jn).norm(), 1e-6 * J.norm());
+		EXPECT_LT((C_world - J * m.C_R * J.transpose()).norm(), 1e-12 * C_world.norm());
+		// A rigid change of frame keeps the determinant of the covariance.
+		EXPECT_NEAR(C_world.determinant(), m.C_R.determinant(), 1e-6 * std::abs(m.C_R.determinant()));
+	}
+}
+
+TEST(Composition, CameraPlanarPoseOfMountedCamera)
+{
+	const CPose3D level_fwd(0.3, -0.1, 0.5, -M_PI / 2, 0, -M_PI / 2);
+	const CPose2D p = cameraPlanarPose(level_fwd);
+	EXPECT_NEAR(p.x(), 0.3, 1e-12);
+	EXPECT_NEAR(p.y(), -0.1, 1e-12);
+	EXPECT_NEAR(p.phi(), 0.0, 1e-12);
+	const CPose3D left = CPose3D(0, 0, 0.5, M_PI / 2, 0, 0) + CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	EXPECT_NEAR(cameraPlanarPose(left).phi(), M_PI / 2, 1e-12);
+}
+
+TEST(Options, LoadSaveAndMethodNames)
+{
+	EXPECT_EQ(poseMethodFromString("general6dof"), PoseMethod::General6Dof);
+	EXPECT_EQ(poseMethodFromString("ClosedForm"), PoseMethod::ClosedForm);
+	EXPECT_THROW(poseMethodFromString("pnp"), std::invalid_argument);
+	PoseOptions o;
+	EXPECT_DOUBLE_EQ(o.sigma_px, kDefaultSigmaPx);
+	o.method = PoseMethod::General6Dof;
+	o.sigma_px = 0.2;
+	mrpt::config::CConfigFileMemory cfg;
+	o.saveToConfigFile(cfg, "POSE");
+	PoseOptions r;
+	r.loadFromConfigFile(cfg, "POSE");
+	EXPECT_EQ(r.method, PoseMethod::General6Dof);
+	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
+	cfg.write("POSE", "sigma_px", -1.0);
+	EXPECT_THROW(r.loadFromConfigFile(cfg, "POSE"), std::invalid_argument);
+}
