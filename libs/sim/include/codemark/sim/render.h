@@ -54,6 +54,16 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	 * occluder (a grey bar over one side); 0 = none. */
 	double occlusion = 0.0;
 
+	/** Samples per pixel side (n x n per pixel) used only when the camera
+	 * has lens distortion; without distortion the coverage is exact. */
+	int supersampling = 8;
+
+	/** Throws std::invalid_argument naming the key of the first bad value
+	 * (e.g. a negative sigma, jpeg_quality outside 0..100, gain <= 0). */
+	void validate() const;
+
+	/** Reads the keys of this struct from \a section (background by name:
+	 * Flat, Textured or Cluttered; colours as "B G R"), then validate(). */
 	void loadFromConfigFile(
 		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 	void saveToConfigFile(
@@ -76,18 +86,23 @@ struct LandmarkTruth
 	int id = -1;
 	/** Reference points (inner frame corners) in raw (distorted) pixels, in
 	 * the landmark's own order TL, TR, BR, BL as seen from the front (the
-	 * order as they appear in the image for a camera with little roll). */
+	 * order as they appear in the image for a camera with little roll).
+	 * NaN for a corner that is not in front of the camera. */
 	std::array<Eigen::Vector2d, 4> corners_px;
-	/** The same corners undistorted (ideal pixels, same fx, fy, cx, cy). */
+	/** The same corners undistorted (ideal pixels, same fx, fy, cx, cy);
+	 * NaN for a corner that is not in front of the camera. */
 	std::array<Eigen::Vector2d, 4> corners_ideal_px;
 	/** All of the landmark's outer frame is in front of the camera, inside
-	 * the image, and seen from the front side. */
+	 * the image with a border of at least 1 px (0.5 <= u <= width - 1.5,
+	 * likewise v), and seen from the front side. */
 	bool fully_visible = false;
 	bool in_front = false;  //!< the landmark centre is in front of the camera
 	bool facing = false;  //!< the camera is on the printed side
 	double occluded_fraction = 0;  //!< as rendered
-	double area_px = 0;  //!< area of the reference square in the image [px^2]
-	Eigen::Vector4d P = Eigen::Vector4d::Zero();  //!< exact primary measurement
+	double area_px = 0;  //!< area of the reference square in the image (raw corners) [px^2]; 0 unless all corners are in front
+	/** Exact primary measurement (primaryMeasurementFromIdeal of
+	 * corners_ideal_px); zero unless all corners are in front. */
+	Eigen::Vector4d P = Eigen::Vector4d::Zero();
 	SightingTruth sighting;  //!< L and the camera's planar pose in frame L
 	mrpt::poses::CPose3D landmark_T_camera;  //!< exact 6-DoF pose
 };
@@ -99,8 +114,21 @@ struct Render
 	std::vector<LandmarkTruth> truth;  //!< one per map landmark, map order
 };
 
-/** Renders \a scene. Deterministic for a given seed. */
+/** Renders \a scene. Deterministic for a given seed. Landmarks are drawn
+ * far to near over the background; a landmark seen from behind (not facing)
+ * is not drawn (its back is the wall it hangs on). Throws
+ * std::invalid_argument on invalid options. */
 Render render(const Scene& scene, const RenderOptions& options, uint64_t seed);
+
+/** The ground truth of render() without rendering (cheap): one entry per
+ * map landmark, map order; occluded_fraction is 0. */
+std::vector<LandmarkTruth> groundTruth(const Scene& scene);
+
+/** The name of \a b as read by RenderOptions ("Flat", "Textured", "Cluttered"). */
+const char* backgroundName(Background b);
+/** The Background named \a name (case-insensitive); throws
+ * std::invalid_argument otherwise. */
+Background backgroundFromName(const std::string& name);
 
 /** A level camera (optical axis horizontal, no roll) at distance
  * \a distance_m from \a landmark's centre, seen at \a view_angle_rad between
