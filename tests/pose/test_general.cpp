@@ -1,0 +1,235 @@
+// The general 6-DoF path: the exactly-180-degree case that OpenCV 4.6's
+// SOLVEPNP_IPPE_SQUARE gets wrong, agreement with the closed form for level
+// cameras, tilted cameras with lens distortion, ambiguity and covariance.
+#include <codemark/landmark/truth.h>
+#include <codemark/pose/general.h>
+#include <codemark/pose/measurement.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <iostream>
+#include <opencv2/calib3d.hpp>
+#include <random>
+
+#include "common.h"
+
+using namespace codemark;
+using namespace codemark::pose;
+using codemark::test::cameraAt;
+using codemark::test::levelCamera;
+using codemark::test::projectCorners;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+// Rotation angle between two poses [rad] and translation distance [m].
+std::pair<double, double> poseError(const CPose3D& a, const CPose3D& b)
+{
+	const Eigen::Matrix3d dR =
+		a.getRotationMatrix().asEigen().transpose() * b.getRotationMatrix().asEigen();
+	const double ang = std::acos(std::clamp(0.5 * (dR.trace() - 1), -1.0, 1.0));
+	return {ang, (a.translation() - b.translation()).norm()};
+}
+
+CameraModel distortedCamera()
+{
+	mrpt::img::TCamera p;
+	p.ncols = 1280;
+	p.nrows = 960;
+	p.setIntrinsicParamsFromValues(1000, 1000, 639.5, 479.5);
+	p.distortion = mrpt::img::DistortionModel::plumb_bob;
+	p.dist.fill(0);
+	p.dist[0] = -0.25;
+	p.dist[1] = 0.08;
+	p.dist[2] = 0.001;
+	p.dist[3] = -0.0015;
+	p.dist[4] = -0.01;
+	return CameraModel(p);
+}
+}  // namespace
+
+TEST(General, SquarelyFacingLevelCamera180Degrees)
+{
+	// A level camera squarely facing the landmark: yaw exactly 180 deg in L.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
+	for (const double d : {0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0})
+	{
+		for (const double z : {0.0, 0.25})
+		{
+			const CPose3D truth = levelCamera(d, 0, z, M_PI);
+			const auto corners = projectCorners(truth, cam, g);
+			const GeneralPose gp = solveGeneralPose(corners, cam, g, 0.07);
+			const auto [ang, dt] = poseError(gp.solutions[0].landmark_T_camera, truth);
+			EXPECT_LT(ang, 1e-6) << "d " << d << " z " << z;
+			EXPECT_LT(dt, 1e-6 * d) << "d " << d << " z " << z;
+			EXPECT_LT(gp.solutions[0].rms_px, 1e-6);
+			EXPECT_NEAR(std::abs(gp.pose_in_landmark[2]), M_PI, 1e-6);
+
+			// What OpenCV 4.6's SOLVEPNP_IPPE_SQUARE does here (documented, not
+			// asserted: it is OpenCV's behaviour, not ours). Its model is the
+			// square (-h, h, 0), (h, h, 0), (h, -h, 0), (-h, -h, 0): our
+			// modelPoints() order.
+			std::vector<cv::Point3d> obj;
+			for (const auto& m : modelPoints(g)) obj.emplace_back(m.x(), m.y(), m.z());
+			std::vector<cv::Point2d> img;
+			for (const auto& c : corners) img.emplace_back(c.x(), c.y());
+			std::vector<cv::Mat> rv, tv;
+			const int n = cv::solvePnPGeneric(obj, img, K, cv::Mat(), rv, tv, false, cv::SOLVEPNP_IPPE_SQUARE);
+			double best_ang = 1e9, best_dt = 1e9;
+			for (int i = 0; i < n; ++i)
+			{
+				Eigen::Matrix<double, 6, 1> p;
+				p << rv[i].at<double>(0), rv[i].at<double>(1), rv[i].at<double>(2),
+					tv[i].at<double>(0), tv[i].at<double>(1), tv[i].at<double>(2);
+				const auto [a, t] = poseError(landmarkTCameraFromRvecTvec(p), truth);
+				best_ang = std::min(best_ang, a);
+				best_dt = std::min(best_dt, t);
+			}
+			std::cout << "[ IPPE_SQUARE ] d=" << d << " z=" << z << ": " << n
+					  << " solution(s), best rotation error " << best_ang * 180 / M_PI
+					  << " deg, best position error " << best_dt << " m\n";
+			RecordProperty("ippe_square_d" + std::to_string(int(d * 10)) + "_z" +
+					std::to_string(int(z * 100)) + "_rot_err_deg",
+				std::to_string(best_ang * 180 / M_PI));
+		}
+	}
+}
+
+TEST(General, AgreesWithClosedFormForLevelCameras)
+{
+	const CameraModel cam;
+	std::mt19937 rng(11);
+	std::uniform_real_distribution<double> d(0.5, 5.0), a(-1.2, 1.2), z(-0.4, 0.4), p1(-0.3, 0.3);
+	PoseOptions cf, gen;
+	gen.method = PoseMethod::General6Dof;
+	for (int i = 0; i < 100; ++i)
+	{
+		const CPose3D truth = cameraAt(d(rng), a(rng), z(rng), p1(rng));
+		const LandmarkGeometry g;
+		const auto corners = projectCorners(truth, cam, g);
+		const Measurement mc = measure(corners, cam, g, cf);
+		const Measurement mg = measure(corners, cam, g, gen);
+		EXPECT_EQ(mg.method, PoseMethod::General6Dof);
+		EXPECT_NEAR(mg.L[0], mc.L[0], 1e-6 * mc.L[0]);
+		EXPECT_NEAR(mg.L[1], mc.L[1], 1e-6);
+		EXPECT_NEAR(mg.L[2], mc.L[2], 1e-6);
+		EXPECT_LT((mg.pose_in_landmark.head<2>() - mc.pose_in_landmark.head<2>()).norm(), 1e-6 * mc.L[0]);
+		EXPECT_NEAR(wrapToPi(mg.pose_in_landmark[2] - mc.pose_in_landmark[2]), 0, 1e-6);
+		const auto [ang, dt] = poseError(mg.landmark_T_camera, truth);
+		EXPECT_LT(ang, 1e-6);
+		EXPECT_LT(dt, 1e-6 * mc.L[0]);
+		// The general path also knows the height, which the closed form cannot.
+		EXPECT_NEAR(mg.landmark_T_camera.z(), truth.z(), 1e-6);
+		EXPECT_GT(mg.ambiguity_ratio, 1.0);
+	}
+}
+
+TEST(General, TiltedCameraWithLensDistortion)
+{
+	const CameraModel cam = distortedCamera();
+	ASSERT_TRUE(cam.hasDistortion());
+	std::mt19937 rng(12);
+	std::uniform_real_distribution<double> d(0.6, 4.0), a(-1.0, 1.0), z(-0.6, 0.6), yaw(-0.4, 0.4),
+		roll(-0.1, 0.1);
+	const LandmarkGeometry g = LandmarkGeometry::scaled(1.5);
+	int tested = 0;
+	for (int i = 0; i < 200 && tested < 60; ++i)
+	{
+		const double dd = d(rng), aa = a(rng), zz = z(rng);
+		// Heading towards the landmark plus an offset, pitched 10 deg down
+		// (MRPT pitch is about the robot's y: positive = nose down), rolled a little.
+		const CPose3D truth =
+			CPose3D(dd * std::cos(aa), dd * std::sin(aa), zz, aa + M_PI + yaw(rng), 10 * M_PI / 180, roll(rng)) +
+			CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		std::array<Eigen::Vector2d, 4> corners;
+		try
+		{
+			corners = projectCorners(truth, cam, g);
+		}
+		catch (const std::runtime_error&)
+		{
+			continue;
+		}
+		bool inside = true;
+		for (const auto& c : corners)
+			inside = inside && c.x() > 0 && c.y() > 0 && c.x() < cam.width() - 1 && c.y() < cam.height() - 1;
+		if (!inside) continue;
+		++tested;
+		PoseOptions gen;
+		gen.method = PoseMethod::General6Dof;
+		const Measurement m = measure(corners, cam, g, gen);
+		const auto [ang, dt] = poseError(m.landmark_T_camera, truth);
+		EXPECT_LT(ang, 1e-6) << "i " << i;
+		EXPECT_LT(dt, 1e-6 * dd) << "i " << i;
+		const SightingTruth st = sightingTruth(truth);
+		EXPECT_NEAR(m.L[0], st.L[0], 1e-6 * st.L[0]);
+		EXPECT_NEAR(m.L[1], st.L[1], 1e-6);
+		EXPECT_NEAR(m.L[2], st.L[2], 1e-6);
+		EXPECT_NEAR(wrapToPi(m.pose_in_landmark[2] - st.pose_in_landmark[2]), 0, 1e-6);
+		// The closed form, which assumes a level camera, is biased here.
+		PoseOptions cf;
+		const Measurement mc = measure(corners, cam, g, cf);
+		EXPECT_GT(std::abs(mc.L[0] - st.L[0]), 1e-4 * st.L[0]) << "i " << i;
+	}
+	EXPECT_GE(tested, 30);
+}
+
+TEST(General, CovarianceMatchesMonteCarlo)
+{
+	// Perturb the corners with independent noise: the empirical covariance of
+	// (L, pose) against the predicted one (first order holds at 1.5 m).
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const double sigma_c = 0.1;
+	const CPose3D truth = cameraAt(1.5, 0.5, 0.2, 0.1);
+	const auto corners = projectCorners(truth, cam, g);
+	const GeneralPose ref = solveGeneralPose(corners, cam, g, sigma_c);
+	std::mt19937 rng(13);
+	std::normal_distribution<double> n(0, sigma_c);
+	const int N = 2000;
+	std::vector<Eigen::Matrix<double, 6, 1>> v;
+	for (int i = 0; i < N; ++i)
+	{
+		auto c = corners;
+		for (auto& p : c) p += Eigen::Vector2d(n(rng), n(rng));
+		const GeneralPose gp = solveGeneralPose(c, cam, g, sigma_c);
+		Eigen::Matrix<double, 6, 1> x;
+		x << gp.L - ref.L, gp.pose_in_landmark - ref.pose_in_landmark;
+		x[2] = wrapToPi(x[2]);
+		x[5] = wrapToPi(x[5]);
+		v.push_back(x);
+	}
+	Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+	for (const auto& x : v) mean += x / N;
+	Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+	for (const auto& x : v) C += (x - mean) * (x - mean).transpose() / (N - 1);
+	const Eigen::Matrix3d CL = C.topLeftCorner<3, 3>(), CR = C.bottomRightCorner<3, 3>();
+	EXPECT_LT((CL - ref.C_L).norm() / ref.C_L.norm(), 0.15);
+	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.15);
+}
+
+TEST(General, AmbiguityAndBothSolutions)
+{
+	// A small, distant, oblique landmark: the two IPPE solutions are both
+	// kept and the noise-free one wins clearly.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const CPose3D truth = cameraAt(4.0, 0.6, 0.0, 0.0);
+	const GeneralPose gp = solveGeneralPose(projectCorners(truth, cam, g), cam, g, 0.07);
+	ASSERT_EQ(gp.solutions.size(), 2u);
+	EXPECT_LE(gp.solutions[0].rms_px, gp.solutions[1].rms_px);
+	EXPECT_GT(gp.ambiguity_ratio, 10.0);
+	const auto [ang, dt] = poseError(gp.solutions[0].landmark_T_camera, truth);
+	EXPECT_LT(ang, 1e-6);
+	EXPECT_LT(dt, 1e-5);
+	// The other solution mirrors the landmark's tilt: a different pose.
+	const auto [ang2, dt2] = poseError(gp.solutions[1].landmark_T_camera, truth);
+	EXPECT_GT(ang2 + dt2, 1e-3);
+	// The covariance is symmetric positive definite.
+	const Eigen::Matrix<double, 6, 6> C = gp.solutions[0].cov;
+	EXPECT_LT((C - C.transpose()).norm(), 1e-12 * C.norm());
+	using Mat6 = Eigen::Matrix<double, 6, 6>;
+	EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(C).eigenvalues().minCoeff(), 0);
+}
