@@ -46,7 +46,7 @@ CObservationCodedLandmarks makeFilled()
 		s.quality.code_margin = 55.5;
 		s.quality.area_px = 3300;
 		s.quality.corner_sigma_px = 0.02;
-		s.method = k ? codemark::PoseMethod::General6Dof : codemark::PoseMethod::ClosedForm;
+		s.method = k ? codemark::pose::PoseMethod::General6Dof : codemark::pose::PoseMethod::ClosedForm;
 		o.sightings.push_back(s);
 	}
 	return o;

@@ -28,6 +28,23 @@ double deg(double rad) { return rad * 180.0 / M_PI; }
 double sd(double var) { return var > 0 ? std::sqrt(var) : 0.0; }
 }  // namespace
 
+CObservationCodedLandmarks::TSighting CObservationCodedLandmarks::TSighting::From(
+	const Detection& d, const pose::Measurement& m)
+{
+	TSighting s;
+	s.id = d.id;
+	s.corners = d.corners;
+	s.quality = d.quality;
+	s.P = m.P;
+	s.C_P = m.C_P;
+	s.L = m.L;
+	s.C_L = m.C_L;
+	s.pose_in_landmark = m.pose_in_landmark;
+	s.C_R = m.C_R;
+	s.method = m.method;
+	return s;
+}
+
 uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 0; }
 
 void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
@@ -47,6 +64,7 @@ void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out)
 		for (double v : s.quality.line_rms_px) out << v;
 		for (int v : s.quality.line_support) out.WriteAs<int32_t>(v);
 		out << s.quality.code_margin << s.quality.area_px << s.quality.corner_sigma_px;
+		// Stored as pose::PoseMethod's value: ClosedForm = 0, General6Dof = 1.
 		out.WriteAs<uint8_t>(static_cast<uint8_t>(s.method));
 	}
 }
@@ -81,11 +99,11 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 				for (int& v : s.quality.line_support) v = in.ReadAs<int32_t>();
 				in >> s.quality.code_margin >> s.quality.area_px >> s.quality.corner_sigma_px;
 				const auto m = in.ReadAs<uint8_t>();
-				if (m > static_cast<uint8_t>(PoseMethod::General6Dof))
+				if (m > static_cast<uint8_t>(pose::PoseMethod::General6Dof))
 					THROW_EXCEPTION_FMT(
 						"CObservationCodedLandmarks: corrupt data, pose method %u",
 						static_cast<unsigned>(m));
-				s.method = static_cast<PoseMethod>(m);
+				s.method = static_cast<pose::PoseMethod>(m);
 			}
 		}
 		break;
@@ -105,7 +123,7 @@ void CObservationCodedLandmarks::getDescriptionAsText(std::ostream& o) const
 	for (const auto& s : sightings)
 	{
 		o << "\n  ID " << s.id << "  ("
-		  << (s.method == PoseMethod::ClosedForm ? "closed form" : "general 6-DoF") << ")\n";
+		  << (s.method == pose::PoseMethod::ClosedForm ? "closed form" : "general 6-DoF") << ")\n";
 		o << std::setprecision(3) << "    range l2    = " << s.L[0] << " m  +- "
 		  << sd(s.C_L(0, 0)) << " m\n";
 		o << std::setprecision(2) << "    bearing phi1 = " << deg(s.L[1]) << " deg  +- "

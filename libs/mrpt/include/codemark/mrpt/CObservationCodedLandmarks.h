@@ -6,6 +6,7 @@
  * rawlog-edit) can read once the plugin library is loaded.
  */
 #include <codemark/landmark/detection.h>
+#include <codemark/pose/measurement.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CObservationBearingRange.h>
@@ -18,13 +19,6 @@
 
 namespace codemark
 {
-/** Which pose path produced a sighting's measurement. */
-enum class PoseMethod : uint8_t
-{
-	ClosedForm = 0,  //!< the paper's closed form P -> L (level camera)
-	General6Dof = 1  //!< planar PnP from the four corners, reduced to L
-};
-
 /** A landmark observation (sensor label by convention `<CAM>_LANDMARKS`,
  * landmark-spec.md section 6), with the timestamp and camera pose of the
  * image it was detected in. */
@@ -49,7 +43,10 @@ class CObservationCodedLandmarks : public mrpt::obs::CObservation
 		Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();
 		Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();  //!< covariance of that pose
 		DetectionQuality quality;
-		PoseMethod method = PoseMethod::ClosedForm;
+		pose::PoseMethod method = pose::PoseMethod::ClosedForm;  //!< which path produced L
+
+		/** A sighting from a detection and its measurement. */
+		static TSighting From(const Detection& d, const pose::Measurement& m);
 	};
 
 	CObservationCodedLandmarks() = default;
