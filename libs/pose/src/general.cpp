@@ -30,11 +30,16 @@ cv::Mat distCoeffs(const CameraModel& cam)
 	return d;
 }
 
-// Model frame M: x = Y_L (right), y = Z_L (up), z = X_L (outward normal).
+// Model frame M: x = Y_L (right), y = -Z_L (down), z = -X_L (into the wall),
+// so that a level camera squarely facing the landmark has R = identity.
+// With the model "y up, z out" (OpenCV's IPPE_SQUARE layout) that camera has
+// a rotation of exactly pi, where OpenCV 4.6's IPPE solutions come out wrong
+// (the rotation-matrix -> Rodrigues conversion is ill-posed at pi; see
+// tests/pose/test_general.cpp, General.SquarelyFacingLevelCamera180Degrees).
 Eigen::Matrix3d landmarkRModel()
 {
 	Eigen::Matrix3d R;
-	R << 0, 0, 1, 1, 0, 0, 0, 1, 0;
+	R << 0, 0, -1, 1, 0, 0, 0, -1, 0;
 	return R;
 }
 
@@ -90,8 +95,8 @@ bool samePose(const Vec6& a, const Vec6& b)
 std::array<Eigen::Vector3d, 4> modelPoints(const LandmarkGeometry& g)
 {
 	const double h = g.innerHalf();
-	return {Eigen::Vector3d(-h, h, 0), Eigen::Vector3d(h, h, 0), Eigen::Vector3d(h, -h, 0),
-			Eigen::Vector3d(-h, -h, 0)};
+	return {Eigen::Vector3d(-h, -h, 0), Eigen::Vector3d(h, -h, 0), Eigen::Vector3d(h, h, 0),
+			Eigen::Vector3d(-h, h, 0)};
 }
 
 mrpt::poses::CPose3D landmarkTCameraFromRvecTvec(const Eigen::Matrix<double, 6, 1>& p)

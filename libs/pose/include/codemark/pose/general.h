@@ -7,9 +7,12 @@
  *
  * OpenCV 4.6's SOLVEPNP_IPPE_SQUARE returns a wrong pose while reporting
  * success for many exactly-180-degree configurations (a level camera squarely
- * facing a wall landmark; see tests/pose/test_general.cpp). This path uses
- * SOLVEPNP_IPPE (both solutions) plus SOLVEPNP_SQPNP as candidates, each
- * refined by cv::solvePnPRefineLM on the raw-pixel reprojection error.
+ * facing a wall landmark; see tests/pose/test_general.cpp), and so does
+ * SOLVEPNP_IPPE with that model: the camera's rotation is then exactly pi.
+ * This path puts the model frame so that such a camera has the identity
+ * rotation instead, and uses SOLVEPNP_IPPE (both solutions) plus
+ * SOLVEPNP_SQPNP as candidates, each refined by cv::solvePnPRefineLM on the
+ * raw-pixel reprojection error.
  */
 #include <codemark/landmark/camera.h>
 #include <codemark/landmark/geometry.h>
@@ -26,7 +29,8 @@ struct PnPSolution
 {
 	mrpt::poses::CPose3D landmark_T_camera;  //!< optical frame in frame L
 	/** OpenCV's parameters of the landmark model in the camera frame: rvec
-	 * (Rodrigues, rad) and tvec [m], model frame M = (Y_L, Z_L, X_L). */
+	 * (Rodrigues, rad) and tvec [m], model frame M = (Y_L, -Z_L, -X_L)
+	 * (identity rotation for a level camera squarely facing the landmark). */
 	Eigen::Matrix<double, 6, 1> rvec_tvec = Eigen::Matrix<double, 6, 1>::Zero();
 	double rms_px = 0;  //!< RMS reprojection error over the 8 corner coordinates [px]
 	/** Covariance of rvec_tvec from the corner noise: sigma^2 (J^T J)^-1, J the
@@ -61,11 +65,12 @@ GeneralPose solveGeneralPose(
 	const LandmarkGeometry& geometry, double corner_sigma_px, int lm_max_iterations = 30);
 
 /** The landmark_T_camera of OpenCV's (rvec, tvec) of the model frame
- * M = (Y_L, Z_L, X_L) in the camera frame. */
+ * M = (Y_L, -Z_L, -X_L) in the camera frame. */
 mrpt::poses::CPose3D landmarkTCameraFromRvecTvec(const Eigen::Matrix<double, 6, 1>& rvec_tvec);
 
-/** The reference points in the model frame M used for PnP: (s, t, 0) with s
- * right and t up as seen from the front, in the order TL, TR, BR, BL. */
+/** The reference points in the model frame M = (Y_L, -Z_L, -X_L) used for
+ * PnP: (s, -t, 0) with s right and t up as seen from the front, in the order
+ * TL, TR, BR, BL. */
 std::array<Eigen::Vector3d, 4> modelPoints(const LandmarkGeometry& geometry);
 
 }  // namespace codemark::pose
