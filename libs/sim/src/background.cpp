@@ -18,14 +18,20 @@ uint64_t streamSeed(uint64_t seed, uint64_t stream)
 
 namespace
 {
-/** A smooth random field: Gaussian noise on a coarse grid (one node per
- * \a cell_px), upsampled bicubically, unit variance roughly. */
+/** A smooth random field of about unit variance and correlation length
+ * \a cell_px: white noise on a grid of cell_px / 4 spacing, low-pass filtered
+ * there (Gaussian, 2 grid steps) and upsampled bicubically. Filtering before
+ * upsampling keeps the bicubic grid pattern invisible and costs little. */
 cv::Mat smoothField(cv::RNG& rng, int width, int height, double cell_px, int channels)
 {
-	const int gw = std::max(2, static_cast<int>(std::ceil(width / cell_px)) + 2);
-	const int gh = std::max(2, static_cast<int>(std::ceil(height / cell_px)) + 2);
+	const double step = std::max(1.0, cell_px / 4);
+	const int gw = std::max(4, static_cast<int>(std::ceil(width / step)) + 1);
+	const int gh = std::max(4, static_cast<int>(std::ceil(height / step)) + 1);
 	cv::Mat grid(gh, gw, CV_32FC(channels));
 	rng.fill(grid, cv::RNG::NORMAL, 0.0, 1.0);
+	constexpr double sigma = 2.0;
+	cv::GaussianBlur(grid, grid, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
+	grid *= 2 * std::sqrt(CV_PI) * sigma;  // the blur divides the variance by 4 pi sigma^2
 	cv::Mat up;
 	cv::resize(grid, up, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
 	return up;
