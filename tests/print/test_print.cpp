@@ -430,8 +430,13 @@ TEST(PrintRun, RejectsBadOptionsWithOneClearLine)
 	expectInvalid(o, "dpi must be in 10..1200");
 	o.dpi = 600;
 	o.sheet = true;
-	o.scale = 1.1;  // a 230 mm tile on a 210 mm page
-	expectInvalid(o, "A4");
+	o.scale = 1.1;  // a 220 mm frame on a 210 mm page
+	expectInvalid(o, "does not fit on A4");
+	o.scale = 1.0;
+	o.paper_border_mm = 5.5;  // 200 + 2 x 5.5 > 210
+	expectInvalid(o, "does not fit on A4");
+	o.paper_border_mm = -1;
+	expectInvalid(o, "paper border");
 	o = options({37}, dir.str(), "svg");
 	o.landmark_ini = (dir.path.parent_path() / "no-such-landmark.ini").string();
 	expectInvalid(o, "no-such-landmark.ini");
@@ -509,43 +514,57 @@ TEST(PrintSheet, HalfScaleSheetHoldsSeveralDisjointLandmarks)
 {
 	const LandmarkGeometry g = LandmarkGeometry::scaled(0.5);
 	EXPECT_EQ(landmarksPerSheet(LandmarkGeometry::scaled(1.0)), 1);
-	EXPECT_GE(landmarksPerSheet(g), 4);
+	EXPECT_EQ(landmarksPerSheet(g), 4) << "2 x 2 at scale 0.5 with the 3 mm border";
+	EXPECT_EQ(landmarksPerSheet(g, 4.2), 2) << "one column with a 4.2 mm border";
+	EXPECT_EQ(landmarksPerSheet(LandmarkGeometry::scaled(1.0), 5.5), 0);
 	EXPECT_EQ(landmarksPerSheet(LandmarkGeometry::scaled(1.1)), 0);
+	EXPECT_GE(landmarksPerSheet(LandmarkGeometry::scaled(0.25)), 12);
 
 	std::vector<int> ids;
 	for (int id = 0; id < 10; ++id) ids.push_back(id * 25);
-	std::vector<std::vector<Placement>> placed;
-	const auto pages = sheetPages(g, ids, &placed);
-	const int per_page = landmarksPerSheet(g);
-	ASSERT_EQ(pages.size(), static_cast<std::size_t>((10 + per_page - 1) / per_page));
-	ASSERT_EQ(placed.size(), pages.size());
-	EXPECT_EQ(static_cast<int>(placed[0].size()), per_page);
-	std::size_t total = 0;
-	const double frame = 100, margin = 2.5;  // scale 0.5
-	for (const auto& page_placements : placed)
+	for (double border : {kDefaultPaperBorder_mm, 0.0, 4.2})
 	{
-		total += page_placements.size();
-		for (std::size_t i = 0; i < page_placements.size(); ++i)
+		std::vector<std::vector<Placement>> placed;
+		const auto pages = sheetPages(g, ids, border, &placed);
+		const int per_page = landmarksPerSheet(g, border);
+		ASSERT_GT(per_page, 1);
+		ASSERT_EQ(pages.size(), static_cast<std::size_t>((10 + per_page - 1) / per_page));
+		ASSERT_EQ(placed.size(), pages.size());
+		EXPECT_EQ(static_cast<int>(placed[0].size()), per_page);
+		std::size_t total = 0;
+		const double frame = 100, margin = 2.5;  // scale 0.5
+		const double edge = std::max(margin, border) - 1e-9;
+		for (const auto& page_placements : placed)
 		{
-			const Placement& a = page_placements[i];
-			// Frame plus quiet margin inside the paper.
-			EXPECT_GE(a.frame_x_mm - margin, -1e-9);
-			EXPECT_GE(a.frame_y_mm - margin, -1e-9);
-			EXPECT_LE(a.frame_x_mm + frame + margin, kA4Width_mm + 1e-9);
-			EXPECT_LE(a.frame_y_mm + frame + margin, kA4Height_mm + 1e-9);
-			for (std::size_t j = i + 1; j < page_placements.size(); ++j)
+			total += page_placements.size();
+			for (std::size_t i = 0; i < page_placements.size(); ++i)
 			{
-				const Placement& b = page_placements[j];
-				// The frames with their quiet margins are disjoint.
-				const bool apart_x =
-					std::abs(a.frame_x_mm - b.frame_x_mm) >= frame + 2 * margin - 1e-9;
-				const bool apart_y =
-					std::abs(a.frame_y_mm - b.frame_y_mm) >= frame + 2 * margin - 1e-9;
-				EXPECT_TRUE(apart_x || apart_y) << a.id << " overlaps " << b.id;
+				const Placement& a = page_placements[i];
+				// The frame keeps its quiet margin and the printer's border
+				// from the paper's edge; the label stays inside the border.
+				EXPECT_GE(a.frame_x_mm, edge);
+				EXPECT_GE(a.frame_y_mm, edge);
+				EXPECT_LE(a.frame_x_mm + frame, kA4Width_mm - edge);
+				EXPECT_LE(a.frame_y_mm + frame, kA4Height_mm - edge);
+				EXPECT_GE(a.ink_x_mm, border - 1e-9);
+				EXPECT_LE(a.ink_x_mm + a.ink_w_mm, kA4Width_mm - border + 1e-9);
+				EXPECT_LE(a.ink_y_mm + a.ink_h_mm, kA4Height_mm - border + 1e-9);
+				EXPECT_GT(a.ink_h_mm, frame + margin) << "the label's band";
+				for (std::size_t j = 0; j < page_placements.size(); ++j)
+				{
+					if (i == j) continue;
+					const Placement& b = page_placements[j];
+					// No ink of b inside a's frame grown by its quiet margin.
+					const double x0 = a.frame_x_mm - margin, x1 = a.frame_x_mm + frame + margin;
+					const double y0 = a.frame_y_mm - margin, y1 = a.frame_y_mm + frame + margin;
+					const bool apart = b.ink_x_mm >= x1 - 1e-9 || b.ink_x_mm + b.ink_w_mm <= x0 + 1e-9 ||
+						b.ink_y_mm >= y1 - 1e-9 || b.ink_y_mm + b.ink_h_mm <= y0 + 1e-9;
+					EXPECT_TRUE(apart) << b.id << " intrudes on " << a.id << "'s quiet margin";
+				}
 			}
 		}
+		EXPECT_EQ(total, ids.size());
 	}
-	EXPECT_EQ(total, ids.size());
 
 	// The written sheet: one multi-page PDF of A4 pages and a PNG/SVG per page
 	// in which every landmark reads back.
@@ -554,6 +573,8 @@ TEST(PrintSheet, HalfScaleSheetHoldsSeveralDisjointLandmarks)
 	o.scale = 0.5;
 	o.sheet = true;
 	o.dpi = 150;
+	std::vector<std::vector<Placement>> placed;
+	const auto pages = sheetPages(g, ids, o.paper_border_mm, &placed);
 	const PrintReport report = run(o);
 	EXPECT_EQ(report.pages, static_cast<int>(pages.size()));
 	const auto boxes = pdfMediaBoxes(readFile(dir.path / "codemark-sheet.pdf"));

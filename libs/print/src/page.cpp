@@ -51,49 +51,48 @@ std::string labelText(const LandmarkGeometry& geometry, int id)
 	return s.str();
 }
 
-TileSize tileSize(const LandmarkGeometry& geometry)
+LandmarkExtent landmarkExtent(const LandmarkGeometry& geometry)
 {
-	const double outer = geometry.outer_size_m * 1e3;
-	const double margin = geometry.margin_m * 1e3;
-	TileSize t;
-	t.label_size_mm = std::max(kLabelMinSize_mm, kLabelSizeAtScale1_mm * scaleOf(geometry));
+	LandmarkExtent e;
+	e.frame_mm = geometry.outer_size_m * 1e3;
+	e.margin_mm = geometry.margin_m * 1e3;
+	e.label_size_mm = std::max(kLabelMinSize_mm, kLabelSizeAtScale1_mm * scaleOf(geometry));
 	// The longest label: a three-digit ID.
 	const double label_w =
-		kLabelAdvance_em * t.label_size_mm * static_cast<double>(labelText(geometry, 255).size());
-	t.width_mm = std::max(outer, label_w) + 2 * margin;
-	t.height_mm = 2 * margin + outer + kLabelBand_em * t.label_size_mm;
-	return t;
+		kLabelAdvance_em * e.label_size_mm * static_cast<double>(labelText(geometry, 255).size());
+	e.width_mm = std::max(e.frame_mm, label_w);
+	e.height_mm = e.frame_mm + e.margin_mm + kLabelBand_em * e.label_size_mm;
+	return e;
 }
 
 Placement appendLandmark(
-	Page& page, const LandmarkGeometry& g, int id, double tile_x_mm, double tile_y_mm)
+	Page& page, const LandmarkGeometry& g, int id, double frame_x_mm, double frame_y_mm)
 {
 	const CodeCells cells = encodeId(id);  // throws outside 0..255
-	const TileSize tile = tileSize(g);
-	const double outer = g.outer_size_m * 1e3;
+	const LandmarkExtent ext = landmarkExtent(g);
+	const double outer = ext.frame_mm;
 	const double inner = g.inner_size_m * 1e3;
 	const double cell = g.cell_size_m * 1e3;
-	const double margin = g.margin_m * 1e3;
 	const std::string prefix = "lm" + std::to_string(id) + "-";
 
 	Placement p;
 	p.id = id;
-	p.tile_x_mm = tile_x_mm;
-	p.tile_y_mm = tile_y_mm;
-	p.frame_x_mm = tile_x_mm + 0.5 * (tile.width_mm - outer);
-	p.frame_y_mm = tile_y_mm + margin;
+	p.frame_x_mm = frame_x_mm;
+	p.frame_y_mm = frame_y_mm;
+	p.ink_x_mm = frame_x_mm + 0.5 * (outer - ext.width_mm);
+	p.ink_y_mm = frame_y_mm;
+	p.ink_w_mm = ext.width_mm;
+	p.ink_h_mm = ext.height_mm;
 
-	page.rects.push_back(
-		{prefix + "tile", tile_x_mm, tile_y_mm, tile.width_mm, tile.height_mm, kWhite});
-	page.rects.push_back({prefix + "frame-outer", p.frame_x_mm, p.frame_y_mm, outer, outer, kBlack});
+	page.rects.push_back({prefix + "frame-outer", frame_x_mm, frame_y_mm, outer, outer, kBlack});
 	const double inset = 0.5 * (outer - inner);
 	page.rects.push_back(
-		{prefix + "fill", p.frame_x_mm + inset, p.frame_y_mm + inset, inner, inner, kGreen});
+		{prefix + "fill", frame_x_mm + inset, frame_y_mm + inset, inner, inner, kGreen});
 
 	// Face coordinates (s right, t up) [m] to page coordinates (x right, y
 	// down) [mm] about the centre of the fill.
-	const double cx = p.frame_x_mm + 0.5 * outer;
-	const double cy = p.frame_y_mm + 0.5 * outer;
+	const double cx = frame_x_mm + 0.5 * outer;
+	const double cy = frame_y_mm + 0.5 * outer;
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)
 		{
@@ -106,58 +105,97 @@ Placement appendLandmark(
 		}
 
 	page.texts.push_back(
-		{labelText(g, id), tile_x_mm + 0.5 * tile.width_mm,
-		 p.frame_y_mm + outer + margin + kLabelBaseline_em * tile.label_size_mm,
-		 tile.label_size_mm});
+		{labelText(g, id), cx,
+		 frame_y_mm + outer + ext.margin_mm + kLabelBaseline_em * ext.label_size_mm,
+		 ext.label_size_mm});
 	return p;
 }
 
 Page landmarkPage(const LandmarkGeometry& geometry, int id)
 {
-	const TileSize tile = tileSize(geometry);
+	const LandmarkExtent e = landmarkExtent(geometry);
 	Page page;
-	page.width_mm = tile.width_mm;
-	page.height_mm = tile.height_mm;
-	appendLandmark(page, geometry, id, 0.0, 0.0);
+	page.width_mm = e.width_mm + 2 * e.margin_mm;
+	page.height_mm = e.height_mm + 2 * e.margin_mm;
+	appendLandmark(page, geometry, id, e.margin_mm + 0.5 * (e.width_mm - e.frame_mm), e.margin_mm);
 	return page;
 }
 
 namespace
 {
-void gridOnA4(const TileSize& tile, int& cols, int& rows)
+// One axis of the sheet's grid: blocks of \a block mm, at least \a gap mm
+// apart, at least \a lo / \a hi mm from the paper's edges. Returns the
+// start of each block, the spare length spread evenly over the n + 1 spaces.
+std::vector<double> fitAxis(double length, double block, double gap, double lo, double hi)
 {
-	cols = static_cast<int>(std::floor((kA4Width_mm + kFitTolerance_mm) / tile.width_mm));
-	rows = static_cast<int>(std::floor((kA4Height_mm + kFitTolerance_mm) / tile.height_mm));
+	std::vector<double> starts;
+	int n = 0;
+	while ((n + 1) * block + n * gap + lo + hi <= length + kFitTolerance_mm) ++n;
+	if (n == 0) return starts;
+	const double spare = std::max(0.0, length - (n * block + (n - 1) * gap + lo + hi)) / (n + 1);
+	for (int i = 0; i < n; ++i) starts.push_back(lo + spare + i * (block + gap + spare));
+	return starts;
+}
+
+struct Grid
+{
+	std::vector<double> ink_x;  // left edge of each column's ink [mm]
+	std::vector<double> ink_y;  // top edge of each row's ink (the frame's top) [mm]
+};
+
+Grid gridOnA4(const LandmarkExtent& e, double border)
+{
+	// Across: the frame needs max(margin, border) from the edge (the paper's
+	// blank border is white, so it counts as quiet margin), and so does a
+	// label wider than the frame (reduced by the overhang). Between columns
+	// one quiet margin of white.
+	const double overhang = 0.5 * (e.width_mm - e.frame_mm);
+	const double edge_x = std::max(std::max(e.margin_mm, border) - overhang, border);
+	// Down: the frame's top needs max(margin, border); below the label's
+	// band the border; between rows one quiet margin above the next frame.
+	Grid g;
+	g.ink_x = fitAxis(kA4Width_mm, e.width_mm, e.margin_mm, edge_x, edge_x);
+	g.ink_y = fitAxis(
+		kA4Height_mm, e.height_mm, e.margin_mm, std::max(e.margin_mm, border), border);
+	return g;
+}
+
+void checkBorder(double border)
+{
+	if (!std::isfinite(border) || border < 0 || border > 50)
+		throw std::invalid_argument(
+			"the paper border must be 0..50 mm, got " + shortNumber(border, 3, 0));
 }
 }  // namespace
 
-int landmarksPerSheet(const LandmarkGeometry& geometry)
+int landmarksPerSheet(const LandmarkGeometry& geometry, double paper_border_mm)
 {
-	int cols = 0, rows = 0;
-	gridOnA4(tileSize(geometry), cols, rows);
-	return cols * rows;
+	checkBorder(paper_border_mm);
+	const Grid g = gridOnA4(landmarkExtent(geometry), paper_border_mm);
+	return static_cast<int>(g.ink_x.size() * g.ink_y.size());
 }
 
 std::vector<Page> sheetPages(
-	const LandmarkGeometry& geometry, const std::vector<int>& ids,
+	const LandmarkGeometry& geometry, const std::vector<int>& ids, double paper_border_mm,
 	std::vector<std::vector<Placement>>* placements)
 {
-	const TileSize tile = tileSize(geometry);
-	int cols = 0, rows = 0;
-	gridOnA4(tile, cols, rows);
-	if (cols < 1 || rows < 1)
+	checkBorder(paper_border_mm);
+	const LandmarkExtent e = landmarkExtent(geometry);
+	const Grid grid = gridOnA4(e, paper_border_mm);
+	const std::size_t cols = grid.ink_x.size();
+	const std::size_t per_page = cols * grid.ink_y.size();
+	if (per_page == 0)
 	{
+		const double need = e.frame_mm + 2 * std::max(e.margin_mm, paper_border_mm);
 		std::ostringstream s;
-		s << "a landmark at this size needs " << shortNumber(tile.width_mm, 1, 0) << " x "
-		  << shortNumber(tile.height_mm, 1, 0)
-		  << " mm (frame, quiet margin and label) but an A4 page is 210 x 297 mm; "
-			 "use a smaller --scale or print without --sheet";
+		s << "a landmark with a " << shortNumber(e.frame_mm, 1, 0)
+		  << " mm frame does not fit on A4 (210 x 297 mm) with a "
+		  << shortNumber(paper_border_mm, 1, 0) << " mm paper border: it needs "
+		  << shortNumber(std::max(need, e.width_mm + 2 * paper_border_mm), 1, 0) << " x "
+		  << shortNumber(e.height_mm + std::max(e.margin_mm, paper_border_mm) + paper_border_mm, 1, 0)
+		  << " mm; use a smaller --scale or --border, or print without --sheet";
 		throw std::invalid_argument(s.str());
 	}
-	// Spread the spare space evenly between the tiles and the paper edges.
-	const double gap_x = std::max(0.0, (kA4Width_mm - cols * tile.width_mm) / (cols + 1));
-	const double gap_y = std::max(0.0, (kA4Height_mm - rows * tile.height_mm) / (rows + 1));
-	const std::size_t per_page = static_cast<std::size_t>(cols * rows);
 
 	std::vector<Page> pages;
 	if (placements) placements->clear();
@@ -169,11 +207,10 @@ std::vector<Page> sheetPages(
 			pages.push_back(Page{kA4Width_mm, kA4Height_mm, {}, {}});
 			if (placements) placements->emplace_back();
 		}
-		const int col = static_cast<int>(slot) % cols;
-		const int row = static_cast<int>(slot) / cols;
+		const double ink_x = grid.ink_x[slot % cols];
+		const double ink_y = grid.ink_y[slot / cols];
 		const Placement p = appendLandmark(
-			pages.back(), geometry, ids[i], gap_x + col * (tile.width_mm + gap_x),
-			gap_y + row * (tile.height_mm + gap_y));
+			pages.back(), geometry, ids[i], ink_x + 0.5 * (e.width_mm - e.frame_mm), ink_y);
 		if (placements) placements->back().push_back(p);
 	}
 	return pages;

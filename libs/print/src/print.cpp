@@ -177,7 +177,8 @@ void validate(const PrintOptions& o)
 	Page largest;
 	if (o.sheet)
 	{
-		if (landmarksPerSheet(g) < 1) sheetPages(g, {o.ids.front()});  // throws the why
+		if (landmarksPerSheet(g, o.paper_border_mm) < 1)
+			sheetPages(g, {o.ids.front()}, o.paper_border_mm);  // throws the why
 		largest.width_mm = kA4Width_mm;
 		largest.height_mm = kA4Height_mm;
 	}
@@ -249,10 +250,11 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 		return report;
 	}
 
-	const std::vector<Page> pages = sheetPages(g, o.ids);
+	const std::vector<Page> pages = sheetPages(g, o.ids, o.paper_border_mm);
 	report.pages = static_cast<int>(pages.size());
 	if (log)
-		*log << "sheet: " << landmarksPerSheet(g) << " landmark(s) per A4 page, "
+		*log << "sheet: " << landmarksPerSheet(g, o.paper_border_mm)
+			 << " landmark(s) per A4 page, "
 			 << pages.size() << " page(s)\n";
 	if (has(Format::Pdf))
 	{

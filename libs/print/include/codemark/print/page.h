@@ -55,24 +55,25 @@ struct Page
 	std::vector<TextLine> texts;
 };
 
-/** Where one landmark sits on a page: the top-left corner of its tile [mm]
- * and of its outer black frame [mm]. */
+/** Where one landmark sits on a page [mm]. */
 struct Placement
 {
 	int id = 0;  //!< landmark ID 0..255
-	double tile_x_mm = 0;  //!< tile (quiet margin + frame + label) left edge [mm]
-	double tile_y_mm = 0;  //!< tile top edge [mm]
-	double frame_x_mm = 0;  //!< outer frame left edge [mm]
-	double frame_y_mm = 0;  //!< outer frame top edge [mm]
+	double frame_x_mm = 0;  //!< outer frame's left edge [mm]
+	double frame_y_mm = 0;  //!< outer frame's top edge [mm]
+	double ink_x_mm = 0;  //!< left edge of everything printed for it (frame, label) [mm]
+	double ink_y_mm = 0;  //!< top edge of the ink (the frame's top) [mm]
+	double ink_w_mm = 0;  //!< width of the ink (frame or estimated label width) [mm]
+	double ink_h_mm = 0;  //!< height of the ink, frame top to below the label's descenders [mm]
 };
 
-/** The white tile around one landmark [mm]: the outer frame, the quiet margin
- * (LandmarkGeometry::margin_m) on all four sides, and below it the band that
- * holds the human-readable label. */
-struct TileSize
+/** The extent of one landmark of a geometry [mm]. */
+struct LandmarkExtent
 {
-	double width_mm = 0;  //!< tile width [mm]
-	double height_mm = 0;  //!< tile height [mm]
+	double frame_mm = 0;  //!< side of the outer frame [mm]
+	double margin_mm = 0;  //!< quiet margin around the frame, kept free of ink [mm]
+	double width_mm = 0;  //!< ink width: the frame or the label, whichever is wider [mm]
+	double height_mm = 0;  //!< ink height: frame, quiet margin, label band [mm]
 	double label_size_mm = 0;  //!< font size of the label [mm]
 };
 
@@ -80,39 +81,51 @@ struct TileSize
 constexpr double kA4Width_mm = 210.0;
 constexpr double kA4Height_mm = 297.0;
 
+/** Default border of the paper that printers leave blank [mm]: most inkjets
+ * print to 3 mm from the edge; many laser printers need 4.2 mm. */
+constexpr double kDefaultPaperBorder_mm = 3.0;
+
 /** The human-readable label printed below the frame, outside the quiet
  * margin, e.g. "codemark ID 37 (scale 1.0, reference square 160 mm)". The
  * scale is inner_size_m relative to the spec's 160 mm. */
 std::string labelText(const LandmarkGeometry& geometry, int id);
 
-/** Size of the tile of one landmark of \a geometry [mm]. The label's font is
- * 3.5 mm at scale 1, proportional to the scale, never below 1.5 mm; the tile
- * widens when the label is wider than the frame and its margins. */
-TileSize tileSize(const LandmarkGeometry& geometry);
+/** The extent of one landmark of \a geometry [mm]. The label's font is
+ * 3.5 mm at scale 1, proportional to the scale, never below 1.5 mm; its
+ * width is estimated for a three-digit ID (0.62 em per character). */
+LandmarkExtent landmarkExtent(const LandmarkGeometry& geometry);
 
-/** Appends the tile of landmark \a id with its top-left corner at
- * (tile_x_mm, tile_y_mm) to \a page: white tile, black outer frame square,
- * green fill of the inner square, the black cells of encodeId(id) (the centre
- * always black), the label. Throws std::out_of_range for an ID outside
- * 0..255. Returns where it went. */
+/** Appends landmark \a id with its outer frame's top-left corner at
+ * (frame_x_mm, frame_y_mm) to \a page: black outer frame square, green fill
+ * of the inner square, the black cells of encodeId(id) (the centre always
+ * black), and the label centred below the frame, outside the quiet margin.
+ * The caller keeps the quiet margin free. Throws std::out_of_range for an ID
+ * outside 0..255. Returns where it went. */
 Placement appendLandmark(
-	Page& page, const LandmarkGeometry& geometry, int id, double tile_x_mm,
-	double tile_y_mm);
+	Page& page, const LandmarkGeometry& geometry, int id, double frame_x_mm,
+	double frame_y_mm);
 
-/** A page holding exactly the tile of landmark \a id. */
+/** A page holding landmark \a id alone: the ink with the quiet margin on
+ * all sides (the landmark's exact size plus margin and label). */
 Page landmarkPage(const LandmarkGeometry& geometry, int id);
 
-/** A4 pages holding the landmarks \a ids in order, as many per page as fit
- * in a grid (columns x rows) with the spare space spread evenly between the
- * tiles and the paper edges. Throws std::invalid_argument when one tile does
- * not fit on A4 portrait. \a placements (optional) receives, per page, where
- * each landmark went. */
+/** How many landmarks of \a geometry fit on one A4 portrait page (columns
+ * x rows; 0 when one does not fit) with every frame at least
+ * max(quiet margin, paper border) from the paper's edge, neighbours'
+ * ink at least one quiet margin from a frame (neighbouring margins may
+ * share their white), and the labels at least the paper border from the
+ * edge. */
+int landmarksPerSheet(
+	const LandmarkGeometry& geometry, double paper_border_mm = kDefaultPaperBorder_mm);
+
+/** A4 pages holding the landmarks \a ids in order, landmarksPerSheet() per
+ * page in a grid, the spare space spread evenly between the landmarks and
+ * the paper edges. Throws std::invalid_argument, saying how much room one
+ * landmark needs, when none fits. \a placements (optional) receives, per
+ * page, where each landmark went. */
 std::vector<Page> sheetPages(
 	const LandmarkGeometry& geometry, const std::vector<int>& ids,
+	double paper_border_mm = kDefaultPaperBorder_mm,
 	std::vector<std::vector<Placement>>* placements = nullptr);
-
-/** How many tiles of \a geometry fit on one A4 page (columns x rows); 0 when
- * one does not fit. */
-int landmarksPerSheet(const LandmarkGeometry& geometry);
 
 }  // namespace codemark::print

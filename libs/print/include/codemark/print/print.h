@@ -4,6 +4,7 @@
  * out the landmarks and write the files. The app only parses arguments.
  */
 #include <codemark/landmark/geometry.h>
+#include <codemark/print/page.h>
 
 #include <iosfwd>
 #include <string>
@@ -45,6 +46,7 @@ struct PrintOptions
 	std::vector<Format> formats = {Format::Svg, Format::Png, Format::Pdf};  //!< files per landmark (or per sheet page)
 	double scale = 1.0;  //!< multiplies every size of the landmark (> 0) [-]
 	bool sheet = false;  //!< lay the landmarks on A4 pages instead of one file each
+	double paper_border_mm = kDefaultPaperBorder_mm;  //!< with sheet: blank border the printer leaves [mm], 0..50
 	double dpi = 600;  //!< PNG resolution [dots per inch], 10..1200
 	std::string landmark_ini;  //!< optional ini whose [LANDMARK] section gives the sizes (then multiplied by scale); empty: the spec's A4 landmark
 };
