@@ -1,0 +1,197 @@
+// codemark-render: renders camera frames of a landmark map with exact ground
+// truth (the demo's render step). A thin main over codemark::sim.
+#include <codemark/sim/frames.h>
+#include <codemark/sim/render.h>
+#include <mrpt/config/CConfigFile.h>
+#include <tclap/CmdLine.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "progress.h"
+
+namespace
+{
+/** The demo's look: a wall with a few distractors, mild noise and blur. */
+codemark::sim::RenderOptions demoOptions()
+{
+	codemark::sim::RenderOptions o;
+	o.background = codemark::sim::Background::Cluttered;
+	o.distractors = 6;
+	o.noise_sigma = 2.0;
+	o.blur_sigma_px = 0.8;
+	return o;
+}
+
+/** One line out of an exception message: MRPT's exceptions carry a banner
+ * and a call stack that say nothing to a user. */
+std::string oneLine(const std::string& what)
+{
+	std::string msg = what;
+	const auto stack = msg.find("Call stack backtrace");
+	if (stack != std::string::npos) msg.resize(stack);
+	std::string out, line;
+	std::istringstream in(msg);
+	while (std::getline(in, line))
+	{
+		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos) continue;
+		out += (out.empty() ? "" : "; ") + line;
+	}
+	return out.empty() ? what : out;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	namespace fs = std::filesystem;
+	using namespace codemark;
+	try
+	{
+		TCLAP::CmdLine cmd(
+			"Renders camera frames of the landmarks of a map with exact ground truth. Writes into "
+			"--out DIR: frame_000.png, frame_001.png, ...; truth.jsonl (one JSON object per frame: "
+			"image, width, height, camera_pose [x y z yaw pitch roll] of the camera body frame "
+			"(x forward, y left, z up; m, rad), and for every landmark in view: id, corners (the four "
+			"inner frame corners in raw pixels, TL TR BR BL), P, L, pose_in_landmark, fully_visible, "
+			"area_px, occluded_fraction); camera.ini (the camera used, MRPT [CAMERA_PARAMS]); "
+			"render.ini (the render options used, section [RENDER]). Deterministic for a seed.",
+			' ', "0.1");
+		TCLAP::ValueArg<std::string> mapArg(
+			"m", "map", "landmark map file ('id x y z yaw_deg [scale]' per line)", true, "", "MAP.txt", cmd);
+		TCLAP::ValueArg<std::string> outArg("o", "out", "output directory (created if missing)", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> cameraArg(
+			"c", "camera",
+			"camera file: MRPT [CAMERA_PARAMS] .ini or ROS/OpenCV calibration .yaml; default: the "
+			"paper's camera (share/codemark/camera-paper.ini: 640x480, f = 800 px, no distortion)",
+			false, "", "CAM.ini|yaml", cmd);
+		TCLAP::ValueArg<std::string> posesArg(
+			"p", "poses",
+			"camera poses, one frame per line: 'x y z yaw pitch roll' (m, deg) of the camera body "
+			"frame (x forward, y left, z up) in the world, '#' comments. Default: --frames level "
+			"poses that look at the map's landmarks in turn",
+			false, "", "POSES.txt", cmd);
+		TCLAP::ValueArg<int> framesArg(
+			"n", "frames", "number of generated poses without --poses (default 8)", false, 8, "N", cmd);
+		TCLAP::ValueArg<uint64_t> seedArg(
+			"s", "seed", "seed of the generated poses and of the renderer's randomness (default 1)", false, 1,
+			"S", cmd);
+		TCLAP::ValueArg<std::string> optionsArg(
+			"", "options",
+			"render options ini (keys of codemark::sim::RenderOptions: background = Flat|Textured|"
+			"Cluttered, distractors, noise_sigma, blur_sigma_px, motion_blur_px, jpeg_quality, gain, "
+			"gradient, occlusion, ...). Keys not given keep the demo defaults: Cluttered (texture with "
+			"6 distractors), noise_sigma 2, blur_sigma_px 0.8",
+			false, "", "RENDER.ini", cmd);
+		TCLAP::ValueArg<std::string> sectionArg(
+			"", "section", "section of --options to read (default RENDER)", false, "RENDER", "NAME", cmd);
+		TCLAP::ValueArg<double> minDistArg(
+			"", "min-distance", "generated poses: least horizontal distance to the landmark [m] (default 0.8)",
+			false, 0.8, "M", cmd);
+		TCLAP::ValueArg<double> maxDistArg(
+			"", "max-distance", "generated poses: greatest horizontal distance [m] (default 4)", false, 4.0,
+			"M", cmd);
+		TCLAP::ValueArg<double> maxAngleArg(
+			"", "max-angle", "generated poses: greatest view angle from the landmark's normal [deg] (default 50)",
+			false, 50.0, "DEG", cmd);
+		TCLAP::ValueArg<double> heightArg(
+			"", "height", "generated poses: camera height in the world [m] (default 0.6)", false, 0.6, "M", cmd);
+		TCLAP::SwitchArg quietArg("q", "quiet", "no progress indication on stderr", cmd);
+		cmd.parse(argc, argv);
+
+		const LandmarkMap map = LandmarkMap::load(mapArg.getValue());
+		if (map.landmarks.empty()) throw std::runtime_error(mapArg.getValue() + ": the map has no landmarks");
+		CameraModel camera;
+		try
+		{
+			camera = cameraArg.isSet() ? CameraModel::load(cameraArg.getValue()) : CameraModel::paperDefault();
+		}
+		catch (const std::exception& e)
+		{
+			const std::string msg = oneLine(e.what());
+			const std::string file = cameraArg.isSet() ? cameraArg.getValue() : "the default camera";
+			throw std::runtime_error(msg.find(file) == std::string::npos ? file + ": " + msg : msg);
+		}
+
+		sim::RenderOptions options = demoOptions();
+		if (optionsArg.isSet())
+		{
+			if (!std::ifstream(optionsArg.getValue()).good())
+				throw std::runtime_error(optionsArg.getValue() + ": cannot open render options file");
+			mrpt::config::CConfigFile cfg(optionsArg.getValue());
+			try
+			{
+				options.loadFromConfigFile(cfg, sectionArg.getValue());
+			}
+			catch (const std::exception& e)
+			{
+				throw std::runtime_error(optionsArg.getValue() + " [" + sectionArg.getValue() + "]: " + e.what());
+			}
+		}
+
+		std::vector<mrpt::poses::CPose3D> poses;
+		if (posesArg.isSet())
+			poses = sim::loadCameraPoses(posesArg.getValue());
+		else
+		{
+			if (framesArg.getValue() < 1) throw std::runtime_error("--frames must be at least 1");
+			sim::ViewpointOptions vp;
+			vp.min_distance_m = minDistArg.getValue();
+			vp.max_distance_m = maxDistArg.getValue();
+			vp.max_view_angle_rad = maxAngleArg.getValue() * M_PI / 180;
+			vp.camera_height_m = heightArg.getValue();
+			poses = sim::viewpointsAroundLandmarks(map, framesArg.getValue(), seedArg.getValue(), vp);
+		}
+
+		const fs::path out(outArg.getValue());
+		fs::create_directories(out);
+		{
+			std::ofstream cam(out / "camera.ini");
+			cam << camera.toIniText();
+			if (!cam) throw std::runtime_error((out / "camera.ini").string() + ": cannot write");
+		}
+		{
+			mrpt::config::CConfigFile cfg((out / "render.ini").string());
+			options.saveToConfigFile(cfg, "RENDER");
+		}
+		std::ofstream truth(out / "truth.jsonl");
+		if (!truth) throw std::runtime_error((out / "truth.jsonl").string() + ": cannot write");
+
+		sim::Scene scene;
+		scene.map = map;
+		scene.camera = camera;
+		app::ProgressBar bar("codemark-render", !quietArg.getValue());
+		int in_view = 0;
+		for (size_t i = 0; i < poses.size(); ++i)
+		{
+			scene.world_T_camera = poses[i];
+			const sim::Render r = sim::render(scene, options, seedArg.getValue() * 1000003ull + i);
+			char name[32];
+			std::snprintf(name, sizeof(name), "frame_%03zu.png", i);
+			if (!cv::imwrite((out / name).string(), r.image))
+				throw std::runtime_error((out / name).string() + ": cannot write image");
+			truth << sim::frameTruthJson(name, scene.world_T_camera, r.truth, camera) << '\n';
+			for (const auto& t : r.truth) in_view += sim::isInView(t, camera);
+			bar.update(static_cast<long>(i + 1), static_cast<long>(poses.size()));
+		}
+		bar.finish();
+		if (!truth.flush()) throw std::runtime_error((out / "truth.jsonl").string() + ": cannot write");
+		std::cout << "codemark-render: " << poses.size() << " frames, " << in_view
+				  << " landmark sightings in view; wrote " << out.string() << "/{frame_*.png,truth.jsonl,camera.ini,render.ini}\n";
+		return 0;
+	}
+	catch (const TCLAP::ArgException& e)
+	{
+		std::cerr << "codemark-render: error: " << e.error() << " (argument " << e.argId() << "); see --help\n";
+		return 1;
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "codemark-render: error: " << oneLine(e.what()) << "\n";
+		return 1;
+	}
+}
