@@ -57,9 +57,9 @@ int main(int argc, char** argv)
 			cmd, false);
 		TCLAP::ValueArg<double> border_arg(
 			"", "border",
-			"With --sheet: the blank border your printer leaves at the paper's edge, 0..50 mm. "
-			"Most inkjets print to 3 mm; many laser printers need 4.2 (then scale 0.5 gives one "
-			"column). Default 3.",
+			"With --sheet: the blank border (0..50 mm) that your printer leaves at the paper's "
+			"edges. Most inkjets print to 3 mm; many laser printers need 4.2 (then scale 0.5 "
+			"gives one column). Default 3. Ignored without --sheet.",
 			false, 3.0, "MM", cmd);
 		TCLAP::ValueArg<double> dpi_arg(
 			"", "dpi", "Resolution of the PNG files, 10..1200 dots per inch. Default 600.", false,

@@ -241,6 +241,37 @@ TEST(PrintPng, ReadBackDecodesTheIdAndMeasuresTheFrame)
 		EXPECT_NEAR(t[t.size() - 2] - t[1], 160.0, tol) << "reference square [mm]";
 		EXPECT_NEAR(t[1] - t[0], 20.0, tol) << "frame bar [mm]";
 
+		// Abutting black cells print as one black area: not a trace of green
+		// along their shared edge (separately antialiased cells leave a seam
+		// of up to 25% green in the pixels the edge crosses).
+		const CodeCells cells = encodeId(id);
+		auto maxGreen = [&](double x0, double y0, double x1, double y1)
+		{
+			const cv::Rect r(
+				cv::Point(int(std::floor(x0 * ppmm)), int(std::floor(y0 * ppmm))),
+				cv::Point(int(std::ceil(x1 * ppmm)), int(std::ceil(y1 * ppmm))));
+			std::vector<cv::Mat> ch;
+			cv::split(img(r), ch);
+			double lo, hi;
+			cv::minMaxLoc(ch[1], &lo, &hi);
+			return hi;
+		};
+		for (int r = 0; r < 3; ++r)
+			for (int c = 0; c < 3; ++c)
+			{
+				const double x = fx + 55 + 30 * c, y = fy + 55 + 30 * r;  // cell's top-left [mm]
+				if (c < 2 && cells[r][c] && cells[r][c + 1])
+				{
+					EXPECT_LE(maxGreen(x + 29, y + 2, x + 31, y + 28), 3)
+						<< "seam right of r" << r << "c" << c << " of ID " << id;
+				}
+				if (r < 2 && cells[r][c] && cells[r + 1][c])
+				{
+					EXPECT_LE(maxGreen(x + 2, y + 29, x + 28, y + 31), 3)
+						<< "seam below r" << r << "c" << c << " of ID " << id;
+				}
+			}
+
 		// The quiet margin is white all round, 2.5 mm off the frame, and
 		// the label lies below it.
 		for (double s = 0; s <= 200; s += 10)

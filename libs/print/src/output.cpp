@@ -86,10 +86,14 @@ void drawPage(cairo_t* cr, const Page& page)
 	cairo_set_source_rgb(cr, 1, 1, 1);
 	cairo_rectangle(cr, 0, 0, page.width_mm, page.height_mm);
 	cairo_fill(cr);
-	for (const FilledRect& r : page.rects)
+	// Consecutive rects of one colour are filled as one path: their union,
+	// so that abutting code cells show no antialiasing seam between them.
+	for (std::size_t i = 0; i < page.rects.size(); ++i)
 	{
-		cairo_set_source_rgb(cr, r.colour.r / 255.0, r.colour.g / 255.0, r.colour.b / 255.0);
+		const FilledRect& r = page.rects[i];
 		cairo_rectangle(cr, r.x_mm, r.y_mm, r.w_mm, r.h_mm);
+		if (i + 1 < page.rects.size() && page.rects[i + 1].colour == r.colour) continue;
+		cairo_set_source_rgb(cr, r.colour.r / 255.0, r.colour.g / 255.0, r.colour.b / 255.0);
 		cairo_fill(cr);
 	}
 	cairo_set_source_rgb(cr, 0, 0, 0);
