@@ -340,10 +340,10 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 	for (double scale : {1.0, 1.5})
 	{
 		TempDir dir("svg");
-		PrintOptions o = options({37}, dir.str(), "svg");
+		PrintOptions o = options({200}, dir.str(), "svg");
 		o.scale = scale;
 		run(o);
-		const std::string svg = readFile(dir.path / "codemark-37.svg");
+		const std::string svg = readFile(dir.path / "codemark-200.svg");
 		const auto roots = svgElements(svg, "svg");
 		ASSERT_EQ(roots.size(), 1u);
 		const double w = mmAttribute(roots[0], "width"), h = mmAttribute(roots[0], "height");
@@ -356,8 +356,8 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 		EXPECT_NEAR(vh, h, 1e-9);
 
 		const auto rects = svgElements(svg, "rect");
-		const Attributes* outer = byId(rects, "lm37-frame-outer");
-		const Attributes* fill = byId(rects, "lm37-fill");
+		const Attributes* outer = byId(rects, "lm200-frame-outer");
+		const Attributes* fill = byId(rects, "lm200-fill");
 		ASSERT_TRUE(outer && fill);
 		EXPECT_NEAR(std::stod(outer->at("width")), 200 * scale, 1e-3);
 		EXPECT_NEAR(std::stod(outer->at("height")), 200 * scale, 1e-3);
@@ -375,16 +375,19 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 		EXPECT_GE(w - ox - 200 * scale, 5 * scale - 1e-3);
 		EXPECT_GE(h - oy - 200 * scale, 5 * scale - 1e-3);
 
-		// The black cells of ID 37 (0b00100101 -> r0c2, r2c0, r2c2) plus the
-		// centre, each 30 mm, at the right place.
-		const CodeCells cells = encodeId(37);
+		// The black cells of ID 200 = 0b11001000 (spec bit order: bits 7, 6, 3
+		// are r0c0, r0c1, r1c2) plus the centre, each 30 mm, at the right
+		// place; an asymmetric ID, so a transposed board fails.
+		const bool expected[3][3] = {{true, true, false}, {false, true, true}, {false, false, false}};
+		const CodeCells cells = encodeId(200);
 		int black = 0;
 		for (int r = 0; r < 3; ++r)
 			for (int c = 0; c < 3; ++c)
 			{
 				const Attributes* cell =
-					byId(rects, "lm37-cell-r" + std::to_string(r) + "c" + std::to_string(c));
+					byId(rects, "lm200-cell-r" + std::to_string(r) + "c" + std::to_string(c));
 				EXPECT_EQ(cell != nullptr, cells[r][c]) << r << "," << c;
+				EXPECT_EQ(cell != nullptr, expected[r][c]) << r << "," << c;
 				if (!cell) continue;
 				++black;
 				EXPECT_NEAR(std::stod(cell->at("width")), 30 * scale, 1e-3);
@@ -398,7 +401,7 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 		ASSERT_EQ(texts.size(), 1u);
 		EXPECT_GT(std::stod(texts[0].at("y")) - std::stod(texts[0].at("font-size")) * 0.8,
 				  oy + 205 * scale);
-		EXPECT_NE(svg.find("codemark ID 37 (scale " + std::string(scale == 1.0 ? "1.0" : "1.5")), std::string::npos);
+		EXPECT_NE(svg.find("codemark ID 200 (scale " + std::string(scale == 1.0 ? "1.0" : "1.5")), std::string::npos);
 		EXPECT_NE(svg.find(scale == 1.0 ? "reference square 160 mm" : "reference square 240 mm"), std::string::npos);
 	}
 }
