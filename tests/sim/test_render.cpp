@@ -507,12 +507,19 @@ TEST(Render, EffectsChangeTheImageAsAsked)
 	o = RenderOptions();
 	o.motion_blur_px = 6;
 	EXPECT_GE(spread(render(scene, o, 5).image), spread(base.image) + 3);
+	// Motion along the (vertical) edge leaves it sharp.
+	o.motion_blur_angle_rad = M_PI / 2;
+	EXPECT_LE(spread(render(scene, o, 5).image), spread(base.image) + 1);
 	// The gradient darkens one side and brightens the other.
 	o = RenderOptions();
 	o.gradient = 0.5;
 	const Render grad = render(scene, o, 5);
 	EXPECT_NEAR(grad.image.at<cv::Vec3b>(240, 0)[0], 128 * 0.75, 1.5);
 	EXPECT_NEAR(grad.image.at<cv::Vec3b>(240, 639)[0], 128 * 1.25, 1.5);
+	o.gradient_angle_rad = M_PI / 2;  // brighter towards the top
+	const Render up = render(scene, o, 5);
+	EXPECT_NEAR(up.image.at<cv::Vec3b>(0, 5)[0], 128 * 1.25, 1.5);
+	EXPECT_NEAR(up.image.at<cv::Vec3b>(479, 5)[0], 128 * 0.75, 1.5);
 	// JPEG changes the pixels a little.
 	o = RenderOptions();
 	o.jpeg_quality = 70;

@@ -19,22 +19,25 @@ uint64_t streamSeed(uint64_t seed, uint64_t stream)
 namespace
 {
 /** A smooth random field of about unit variance and correlation length
- * \a cell_px: white noise on a grid of cell_px / 4 spacing, low-pass filtered
- * there (Gaussian, 2 grid steps) and upsampled bicubically. Filtering before
- * upsampling keeps the bicubic grid pattern invisible and costs little. */
-cv::Mat smoothField(cv::RNG& rng, int width, int height, double cell_px, int channels)
+ * \a cell_px over a width x height image, sampled on a grid of \a grid
+ * nodes spread over the image: white noise on a grid of cell_px / 4
+ * spacing, low-pass filtered there (Gaussian, 2 grid steps) and resampled
+ * bicubically to \a grid. Filtering before upsampling keeps the bicubic
+ * grid pattern invisible and costs little. */
+cv::Mat smoothField(cv::RNG& rng, int width, int height, double cell_px, int channels, const cv::Size& grid)
 {
 	const double step = std::max(1.0, cell_px / 4);
 	const int gw = std::max(4, static_cast<int>(std::ceil(width / step)) + 1);
 	const int gh = std::max(4, static_cast<int>(std::ceil(height / step)) + 1);
-	cv::Mat grid(gh, gw, CV_32FC(channels));
-	rng.fill(grid, cv::RNG::NORMAL, 0.0, 1.0);
+	cv::Mat g(gh, gw, CV_32FC(channels));
+	rng.fill(g, cv::RNG::NORMAL, 0.0, 1.0);
 	constexpr double sigma = 2.0;
-	cv::GaussianBlur(grid, grid, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
-	grid *= 2 * std::sqrt(CV_PI) * sigma;  // the blur divides the variance by 4 pi sigma^2
-	cv::Mat up;
-	cv::resize(grid, up, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
-	return up;
+	cv::GaussianBlur(g, g, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
+	g *= 2 * std::sqrt(CV_PI) * sigma;  // the blur divides the variance by 4 pi sigma^2
+	if (g.size() == grid) return g;
+	cv::Mat out;
+	cv::resize(g, out, grid, 0, 0, cv::INTER_CUBIC);
+	return out;
 }
 
 /** Draws shapes in a local frame (centre, rotation, unit = 1 px) with
@@ -137,16 +140,22 @@ cv::Mat makeBackground(const RenderOptions& o, int width, int height, uint64_t s
 	const double g = o.background_grey;
 	if (o.background == Background::Flat) return cv::Mat(height, width, CV_32FC3, cv::Scalar(g, g, g));
 
-	// A wall: smooth luminance at two scales plus a faint colour tint.
+	// A wall: smooth luminance at two scales plus a faint colour tint,
+	// summed on the finest field's grid (3 px) and upsampled once.
 	cv::RNG rng(streamSeed(seed, 1));
-	const cv::Mat coarse = smoothField(rng, width, height, 96, 1);
-	const cv::Mat fine = smoothField(rng, width, height, 12, 1);
-	const cv::Mat tint = smoothField(rng, width, height, 160, 3);
-	cv::Mat lum = g + 25 * coarse + 7 * fine;
-	std::vector<cv::Mat> ch(3, lum);
+	constexpr double kFineCell = 12, kCoarseCell = 96, kTintCell = 160;
+	const cv::Size grid(
+		std::max(4, static_cast<int>(std::ceil(width / (kFineCell / 4))) + 1),
+		std::max(4, static_cast<int>(std::ceil(height / (kFineCell / 4))) + 1));
+	const cv::Mat coarse = smoothField(rng, width, height, kCoarseCell, 1, grid);
+	const cv::Mat fine = smoothField(rng, width, height, kFineCell, 1, grid);
+	const cv::Mat tint = smoothField(rng, width, height, kTintCell, 3, grid);
+	const cv::Mat lum = g + 25 * coarse + 7 * fine;
+	cv::Mat small;
+	cv::merge(std::vector<cv::Mat>(3, lum), small);
+	small += 6 * tint;
 	cv::Mat bg;
-	cv::merge(ch, bg);
-	bg += 6 * tint;
+	cv::resize(small, bg, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
 	if (o.background == Background::Textured || o.distractors == 0) return bg;
 
 	// Distractors are drawn in 8 bits for OpenCV's anti-aliasing (float

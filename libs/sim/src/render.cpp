@@ -404,7 +404,8 @@ void applyIllumination(cv::Mat& img, const RenderOptions& o)
 		cv::Vec3f* p = img.ptr<cv::Vec3f>(v);
 		for (int u = 0; u < img.cols; ++u)
 		{
-			const double d = ((u - cu) * ca + (v - cv_) * sa) / extent;
+			// Counter-clockwise as displayed: v grows downwards.
+			const double d = ((u - cu) * ca - (v - cv_) * sa) / extent;
 			p[u] *= static_cast<float>(o.gain * (1 + o.gradient * d));
 		}
 	}

@@ -41,17 +41,25 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	cv::Scalar green_bgr{0, 255, 0};  //!< fluorescent green: sRGB #00FF00
 
 	double gain = 1.0;  //!< illumination gain (multiplies all intensities)
-	double gradient = 0.0;  //!< relative gain change across the image (0.5: +-25% from the centre)
-	double gradient_angle_rad = 0.0;  //!< direction of the gradient in the image
+	/** Relative gain change across the image along gradient_angle_rad:
+	 * the gain grows linearly from gain * (1 - gradient/2) to
+	 * gain * (1 + gradient/2) (0.5: +-25% from the centre); |gradient| < 2. */
+	double gradient = 0.0;
+	/** Direction in which the gain grows, counter-clockwise from +u as
+	 * displayed (pi/2: brighter towards the top) [rad]. */
+	double gradient_angle_rad = 0.0;
 
 	double noise_sigma = 0.0;  //!< Gaussian pixel noise [grey levels]
 	double blur_sigma_px = 0.0;  //!< Gaussian blur [px]
 	double motion_blur_px = 0.0;  //!< length of linear motion blur [px]
-	double motion_blur_angle_rad = 0.0;  //!< its direction in the image
+	/** Direction of the motion, counter-clockwise from +u as displayed [rad]. */
+	double motion_blur_angle_rad = 0.0;
 	int jpeg_quality = 0;  //!< 0 = no JPEG round trip, else 1..100
 
 	/** Fraction [0..1] of each landmark's reference square to hide behind an
-	 * occluder (a grey bar over one side); 0 = none. */
+	 * occluder (a grey bar, level 100 at gain 1, in the landmark's plane,
+	 * covering the square from one side chosen from the seed per landmark,
+	 * and beyond the sheet on that side); 0 = none. */
 	double occlusion = 0.0;
 
 	/** Samples per pixel side (n x n per pixel) used only when the camera
@@ -114,10 +122,15 @@ struct Render
 	std::vector<LandmarkTruth> truth;  //!< one per map landmark, map order
 };
 
-/** Renders \a scene. Deterministic for a given seed. Landmarks are drawn
- * far to near over the background; a landmark seen from behind (not facing)
- * is not drawn (its back is the wall it hangs on). Throws
- * std::invalid_argument on invalid options. */
+/** Renders \a scene. Deterministic for a given seed. In order: the
+ * background (with its distractors); the landmarks far to near, each mixed
+ * in by its exact pixel coverage (or by n x n samples per pixel with lens
+ * distortion) together with its occluder, a landmark seen from behind (not
+ * facing) not drawn (its back is the wall it hangs on); illumination gain
+ * and gradient;
+ * Gaussian blur; motion blur; Gaussian noise; rounding and clamping to
+ * 0..255; the JPEG round trip. Throws std::invalid_argument on invalid
+ * options. */
 Render render(const Scene& scene, const RenderOptions& options, uint64_t seed);
 
 /** The ground truth of render() without rendering (cheap): one entry per
