@@ -1,0 +1,122 @@
+#include <codemark/pipeline/pipeline.h>
+#include <mrpt/img/CImage.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <chrono>
+#include <stdexcept>
+
+namespace codemark::pipeline
+{
+LandmarkGeometry geometryFor(int id, const PipelineOptions& o)
+{
+	if (o.map)
+		if (const auto* l = o.map->find(id); l && l->scale != 1.0)
+		{
+			LandmarkGeometry g = o.geometry;
+			g.outer_size_m *= l->scale;
+			g.inner_size_m *= l->scale;
+			g.cell_size_m *= l->scale;
+			g.margin_m *= l->scale;
+			return g;
+		}
+	return o.geometry;
+}
+
+ImageResult processImage(
+	const cv::Mat& bgr, const CameraModel& camera, const PipelineOptions& o,
+	const std::string& debug_dir)
+{
+	ImageResult r;
+	const auto det = detect::detect(bgr, camera, o.geometry, o.detector, debug_dir);
+	r.timings = det.timings;
+	const auto t0 = std::chrono::steady_clock::now();
+	for (const auto& d : det.landmarks)
+	{
+		MeasuredLandmark m;
+		m.detected = d;
+		try
+		{
+			m.measurement = pose::measure(
+				d.detection.corners, camera, geometryFor(d.detection.id, o), o.pose);
+		}
+		catch (const std::invalid_argument&)
+		{
+			continue;  // degenerate corners: no measurement, no sighting
+		}
+		r.landmarks.push_back(std::move(m));
+	}
+	r.pose_us =
+		std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+	return r;
+}
+
+cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img)
+{
+	cv::Mat m;
+	try
+	{
+		if (img.image.isExternallyStored()) img.image.forceLoad();
+		m = img.image.asCvMatRef();
+	}
+	catch (const std::exception& e)
+	{
+		const std::string f = img.image.isExternallyStored()
+			? img.image.getExternalStorageFileAbsolutePath()
+			: std::string("embedded image");
+		throw std::runtime_error("cannot load image '" + f + "': " + e.what());
+	}
+	if (m.empty())
+	{
+		const std::string f = img.image.isExternallyStored()
+			? img.image.getExternalStorageFileAbsolutePath()
+			: std::string("embedded image");
+		throw std::runtime_error("cannot load image '" + f + "' (missing or empty)");
+	}
+	cv::Mat bgr;
+	if (m.depth() != CV_8U)
+		throw std::runtime_error("image is not 8-bit per channel");
+	if (m.channels() == 1) cv::cvtColor(m, bgr, cv::COLOR_GRAY2BGR);
+	else if (m.channels() == 4)
+		cv::cvtColor(m, bgr, cv::COLOR_BGRA2BGR);
+	else
+		bgr = m;
+	return bgr;
+}
+
+CObservationCodedLandmarks::Ptr observeImage(
+	const mrpt::obs::CObservationImage& img, const PipelineOptions& o, ImageResult* out)
+{
+	const CameraModel camera = o.camera_override ? *o.camera_override : CameraModel(img.cameraParams);
+	const cv::Mat bgr = imageAsBgr(img);
+	if (bgr.cols != camera.width() || bgr.rows != camera.height())
+		throw std::runtime_error(
+			"image is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
+			" but the camera is " + std::to_string(camera.width()) + "x" +
+			std::to_string(camera.height()));
+	ImageResult r = processImage(bgr, camera, o);
+	if (img.image.isExternallyStored()) img.image.unload();
+
+	auto obs = CObservationCodedLandmarks::Create();
+	obs->sensorLabel = img.sensorLabel + "_LANDMARKS";
+	obs->timestamp = img.timestamp;
+	obs->cameraPose = img.cameraPose;
+	obs->camera = camera.params();
+	for (const auto& m : r.landmarks)
+		obs->sightings.push_back(
+			CObservationCodedLandmarks::TSighting::From(m.detected.detection, m.measurement));
+	if (out) *out = std::move(r);
+	return obs;
+}
+
+std::string imagesDirectoryOf(const std::string& rawlog_path)
+{
+	const auto slash = rawlog_path.find_last_of('/');
+	const std::string dir = slash == std::string::npos ? "." : rawlog_path.substr(0, slash);
+	std::string name = slash == std::string::npos ? rawlog_path : rawlog_path.substr(slash + 1);
+	if (const auto dot = name.find_last_of('.'); dot != std::string::npos && dot > 0)
+		name.erase(dot);
+	return (dir.empty() ? std::string("/") : dir + "/") + name + "_Images";
+}
+
+}  // namespace codemark::pipeline
