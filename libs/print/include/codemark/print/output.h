@@ -2,9 +2,9 @@
 /** \file output.h
  * Writers of a Page (page.h) at exact physical size: SVG in millimetres
  * (written directly, since cairo's SVG surface uses points and paths), PNG
- * through cairo with the resolution recorded in a pHYs chunk, PDF through
- * cairo's PDF surface. Every writer throws std::runtime_error naming the file
- * when it cannot write it.
+ * drawn by cairo and encoded by OpenCV with the resolution recorded in a pHYs
+ * chunk, PDF through cairo's PDF surface. Every writer throws
+ * std::runtime_error naming the file when it cannot write it.
  */
 #include <codemark/print/page.h>
 
@@ -29,9 +29,10 @@ void pngSize(const Page& page, double dpi, int& width_px, int& height_px);
  * while drawing). */
 void checkPngRaster(const Page& page, double dpi);
 
-/** The PNG file bytes of \a page rendered at \a dpi (antialiased, RGB),
- * with a pHYs chunk of round(dpi / 0.0254) pixels per metre on both axes.
- * Throws as checkPngRaster(). */
+/** The PNG file bytes of \a page rendered at \a dpi (antialiased, 8-bit
+ * RGB, one mm = dpi / 25.4 px exactly on both axes), with a pHYs chunk of
+ * round(dpi / 0.0254) pixels per metre on both axes. Throws as
+ * checkPngRaster(). */
 std::string pngBytes(const Page& page, double dpi);
 
 /** Writes pngBytes(page, dpi) to \a path. */
