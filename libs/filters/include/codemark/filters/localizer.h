@@ -1,0 +1,82 @@
+#pragma once
+/** \file localizer.h
+ * The common face of codemark's filters (EKF localization, the paper's
+ * pose-fix EKF, EKF-SLAM, particle filter): one step per processed camera
+ * frame, with the odometry since the previous step and the frame's
+ * observations. Filter cores hold no I/O and no middleware beyond MRPT's
+ * data types.
+ */
+#include <codemark/landmark/map.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace codemark::filters
+{
+/** The robot's pose estimate in the map frame. */
+struct PoseEstimate
+{
+	bool initialized = false;  //!< false until a first fix (global initialisation)
+	mrpt::poses::CPose2D mean;  //!< x, y [m], yaw [rad]
+	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  //!< covariance of (x, y, yaw)
+};
+
+/** What one step did with the frame's sightings. */
+struct StepStats
+{
+	int used = 0;  //!< sightings fused
+	int rejected = 0;  //!< sightings gated out (chi-square) or otherwise rejected
+	int unknown_id = 0;  //!< sightings of IDs not in the map (localization only)
+	bool reinitialized = false;  //!< the filter (re)initialised from landmarks in this step
+};
+
+/** A landmark of a SLAM map with its covariance. */
+struct MappedLandmark
+{
+	MapLandmark landmark;  //!< id, x, y, z, yaw
+	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  //!< covariance of (x, y, yaw) [m, rad]
+};
+
+/** One filter. */
+class Localizer
+{
+   public:
+	virtual ~Localizer() = default;
+
+	/** Name of the method: "ekf", "ekf-pose", "ekf-slam" or "pf". */
+	virtual std::string method() const = 0;
+
+	/** One step. \a odometry: the robot's motion since the previous step
+	 * (its poseChange PDF carries the motion model's uncertainty), or null
+	 * when there is none (first step). \a observations: the frame's
+	 * codemark::CObservationCodedLandmarks and/or
+	 * mrpt::obs::CObservationBearingRange (other classes are ignored). */
+	virtual StepStats step(
+		const mrpt::obs::CActionRobotMovement2D* odometry,
+		const mrpt::obs::CSensoryFrame& observations) = 0;
+
+	/** The current estimate. */
+	virtual PoseEstimate estimate() const = 0;
+
+	/** SLAM methods: the estimated landmark map; empty for localization. */
+	virtual std::vector<MappedLandmark> landmarks() const { return {}; }
+};
+
+/** Creates the filter \a method ("ekf", "ekf-pose", "ekf-slam", "pf") from
+ * the ini \a cfg (share/codemark/config/<method>.ini) and the landmark map
+ * (required for localization, optional prior for SLAM). \a initial, when
+ * given, is the initial pose estimate; otherwise the filter initialises
+ * itself from its first sightings (global initialisation). Throws
+ * std::invalid_argument naming the method or key on bad configuration. */
+std::unique_ptr<Localizer> makeLocalizer(
+	const std::string& method, const mrpt::config::CConfigFileBase& cfg,
+	const LandmarkMap& map, const std::optional<PoseEstimate>& initial = std::nullopt);
+
+}  // namespace codemark::filters
