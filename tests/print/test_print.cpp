@@ -288,6 +288,40 @@ TEST(PrintPng, ReadBackDecodesTheIdAndMeasuresTheFrame)
 	}
 }
 
+// The printed label lies where the layout reserves room for it: below the
+// frame's quiet margin and inside the ink box that sheets keep apart, also
+// at small scales where it is wider than the frame.
+TEST(PrintPng, LabelStaysInsideItsBox)
+{
+	for (double scale : {0.2, 1.0})
+	{
+		const LandmarkGeometry g = LandmarkGeometry::scaled(scale);
+		Page page;
+		page.width_mm = 150 * scale + 60;
+		page.height_mm = 250 * scale + 20;
+		const Placement p = appendLandmark(page, g, 255, 30, 10);
+		const double dpi = 300, ppmm = dpi / kMmPerInch;
+		const std::string png = pngBytes(page, dpi);
+		const cv::Mat img = cv::imdecode(
+			std::vector<unsigned char>(png.begin(), png.end()), cv::IMREAD_GRAYSCALE);
+		ASSERT_FALSE(img.empty());
+		const double below_margin_mm = p.frame_y_mm + 200 * scale + 5 * scale;
+		const int top = static_cast<int>(std::ceil(below_margin_mm * ppmm));
+		std::vector<cv::Point> ink;
+		cv::findNonZero(img.rowRange(top, img.rows) < 128, ink);
+		ASSERT_GT(ink.size(), 20u) << "no label at scale " << scale;
+		const cv::Rect box = cv::boundingRect(ink);
+		EXPECT_GE(box.x / ppmm, p.ink_x_mm) << "scale " << scale;
+		EXPECT_LE((box.x + box.width) / ppmm, p.ink_x_mm + p.ink_w_mm) << "scale " << scale;
+		EXPECT_LE((top + box.y + box.height) / ppmm, p.ink_y_mm + p.ink_h_mm) << "scale " << scale;
+		// Nothing but the label between the frame's margin and the label.
+		std::vector<cv::Point> in_margin;
+		const int frame_bottom = static_cast<int>(std::ceil((p.frame_y_mm + 200 * scale) * ppmm)) + 1;
+		cv::findNonZero(img.rowRange(frame_bottom, top) < 250, in_margin);
+		EXPECT_TRUE(in_margin.empty()) << "ink in the quiet margin at scale " << scale;
+	}
+}
+
 // (b) The PNG records 600 dpi in its pHYs chunk (pixels per metre, unit 1),
 // before the image data, with valid CRCs throughout.
 TEST(PrintPng, PhysChunkStates600Dpi)
