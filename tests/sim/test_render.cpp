@@ -532,3 +532,58 @@ TEST(Render, EffectsChangeTheImageAsAsked)
 	cv::meanStdDev(render(scene, o, 5).image(cv::Rect(0, 0, 100, 100)), mean, sd);
 	EXPECT_GT(sd[0], 3.0);
 }
+
+TEST(Render, EdgesWithDefaultColoursOverClutter)
+{
+	// The printed colours over a cluttered wall: the inner edges are still
+	// exact (measured where the black frame is wide enough for a pure dark
+	// pixel: up to 2 m and 45 deg).
+	const MapLandmark lm = makeLandmark();
+	const CameraModel cam;
+	RenderOptions o;
+	o.background = Background::Cluttered;
+	o.distractors = 30;
+	double worst = 0;
+	for (double d : {0.7, 1.5, 2.0})
+		for (double a_deg : {0.0, 30.0, -45.0})
+		{
+			const Scene scene = makeScene(lm, levelCameraLookingAt(lm, d, a_deg * kDeg, 0.04 * d, -0.05), cam);
+			const Render r = render(scene, o, 9);
+			const auto errs =
+				innerEdgeErrors(greenFraction(r.image), r.truth[0], cam, lm.geometry().cell_size_m);
+			for (int e = 0; e < 4; ++e)
+			{
+				EXPECT_GE(errs[e].size(), 3u) << "edge " << e << " d " << d << " a " << a_deg;
+				EXPECT_LT(maxAbs(errs[e]), 0.02) << "edge " << e << " d " << d << " a " << a_deg;
+				worst = std::max(worst, maxAbs(errs[e]));
+			}
+		}
+	std::cout << "worst edge error, printed colours: " << worst << " px\n";
+}
+
+TEST(Render, NearerLandmarksCoverFartherOnes)
+{
+	MapLandmark far = makeLandmark(255), near = makeLandmark(0);
+	// near: 1 m in front of far, slightly to the side, both facing the camera.
+	near.x_m = far.x_m + std::cos(far.yaw_rad) * 1.0 + 0.05;
+	near.y_m = far.y_m + std::sin(far.yaw_rad) * 1.0;
+	near.yaw_rad = far.yaw_rad;
+	Scene scene;
+	scene.map.landmarks = {near, far};  // map order is not drawing order
+	scene.world_T_camera = levelCameraLookingAt(far, 2.0, 0.0);
+	const Render r = render(scene, RenderOptions(), 1);
+	ASSERT_EQ(r.truth.size(), 2u);
+	EXPECT_EQ(r.truth[0].id, 0);
+	EXPECT_EQ(r.truth[1].id, 255);
+	// The centre of the near landmark's code board: all its cells but the
+	// centre are green (ID 0), although the far one (all black) is behind.
+	const LandmarkGeometry g = near.geometry();
+	for (int row = 0; row < 3; ++row)
+		for (int col = 0; col < 3; ++col)
+		{
+			const Eigen::Vector2d f = g.cellCentreFace(row, col);
+			const Eigen::Vector2d px = facePixel(r.truth[0], scene.camera, f.x(), f.y());
+			const cv::Vec3b v = r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
+			EXPECT_EQ(v[1] < 128, row == 1 && col == 1) << "cell " << row << col;
+		}
+}

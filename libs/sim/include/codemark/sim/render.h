@@ -102,11 +102,12 @@ struct LandmarkTruth
 	std::array<Eigen::Vector2d, 4> corners_ideal_px;
 	/** All of the landmark's outer frame is in front of the camera, inside
 	 * the image with a border of at least 1 px (0.5 <= u <= width - 1.5,
-	 * likewise v), and seen from the front side. */
+	 * likewise v), and seen from the front side. Geometric: occlusion by
+	 * another landmark or by the occluder bar does not change it. */
 	bool fully_visible = false;
 	bool in_front = false;  //!< the landmark centre is in front of the camera
 	bool facing = false;  //!< the camera is on the printed side
-	double occluded_fraction = 0;  //!< as rendered
+	double occluded_fraction = 0;  //!< fraction of the reference square behind the occluder bar, as rendered
 	double area_px = 0;  //!< area of the reference square in the image (raw corners) [px^2]; 0 unless all corners are in front
 	/** Exact primary measurement (primaryMeasurementFromIdeal of
 	 * corners_ideal_px); zero unless all corners are in front. */
