@@ -119,27 +119,50 @@ void CObservationCodedLandmarks::getDescriptionAsText(std::ostream& o) const
 	  << " fy=" << camera.fy() << " cx=" << camera.cx() << " cy=" << camera.cy() << "\n";
 	o << "Coded landmarks seen: " << sightings.size() << "\n";
 	const auto old = o.flags();
-	o << std::fixed;
+	const auto oldp = o.precision();
+	// Values in fixed notation, their 1-sigma with 3 significant digits:
+	// sub-millimetre and millidegree sigmas must not print as 0.
+	auto val = [&](double v, int decimals) -> std::ostream& {
+		return o << std::fixed << std::setprecision(decimals) << v;
+	};
+	auto sig = [&](double v) -> std::ostream& {
+		o.unsetf(std::ios::floatfield);
+		return o << std::setprecision(3) << v;
+	};
 	for (const auto& s : sightings)
 	{
 		o << "\n  ID " << s.id << "  ("
 		  << (s.method == pose::PoseMethod::ClosedForm ? "closed form" : "general 6-DoF") << ")\n";
-		o << std::setprecision(3) << "    range l2    = " << s.L[0] << " m  +- "
-		  << sd(s.C_L(0, 0)) << " m\n";
-		o << std::setprecision(2) << "    bearing phi1 = " << deg(s.L[1]) << " deg  +- "
-		  << deg(sd(s.C_L(1, 1))) << " deg\n";
-		o << "    orientation phi2 = " << deg(s.L[2]) << " deg  +- " << deg(sd(s.C_L(2, 2)))
-		  << " deg\n";
-		o << std::setprecision(3) << "    camera in landmark frame: x = " << s.pose_in_landmark[0]
-		  << " m, y = " << s.pose_in_landmark[1] << " m, theta = " << std::setprecision(2)
-		  << deg(s.pose_in_landmark[2]) << " deg  (1-sigma " << std::setprecision(3)
-		  << sd(s.C_R(0, 0)) << ", " << sd(s.C_R(1, 1)) << " m, " << std::setprecision(2)
-		  << deg(sd(s.C_R(2, 2))) << " deg)\n";
-		o << std::setprecision(2) << "    corners [px]: ";
-		for (const auto& c : s.corners) o << "(" << c.x() << ", " << c.y() << ") ";
-		o << "\n    P = [" << s.P.transpose() << "] px, code margin " << s.quality.code_margin
-		  << ", area " << std::setprecision(0) << s.quality.area_px << " px^2\n";
+		o << "    range l2         = ";
+		val(s.L[0], 4) << " m    +- ";
+		sig(sd(s.C_L(0, 0))) << " m\n";
+		o << "    bearing phi1     = ";
+		val(deg(s.L[1]), 4) << " deg  +- ";
+		sig(deg(sd(s.C_L(1, 1)))) << " deg\n";
+		o << "    orientation phi2 = ";
+		val(deg(s.L[2]), 3) << " deg  +- ";
+		sig(deg(sd(s.C_L(2, 2)))) << " deg\n";
+		o << "    camera in landmark frame: x = ";
+		val(s.pose_in_landmark[0], 4) << " m, y = ";
+		val(s.pose_in_landmark[1], 4) << " m, theta = ";
+		val(deg(s.pose_in_landmark[2]), 3) << " deg  (1-sigma ";
+		sig(sd(s.C_R(0, 0))) << " m, ";
+		sig(sd(s.C_R(1, 1))) << " m, ";
+		sig(deg(sd(s.C_R(2, 2)))) << " deg)\n";
+		o << "    corners [px]: ";
+		for (const auto& c : s.corners)
+		{
+			o << "(";
+			val(c.x(), 3) << ", ";
+			val(c.y(), 3) << ") ";
+		}
+		o << "\n    P = [";
+		for (int i = 0; i < 4; ++i) val(s.P[i], 3) << (i < 3 ? " " : "");
+		o << "] px, code margin ";
+		val(s.quality.code_margin, 1) << ", area ";
+		val(s.quality.area_px, 0) << " px^2\n";
 	}
+	o.precision(oldp);
 	o.flags(old);
 }
 
