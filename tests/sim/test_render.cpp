@@ -390,6 +390,17 @@ TEST(Render, DistortedCornersWhereTheCameraProjects)
 		}
 	}
 	std::cout << "worst distorted edge error: " << worst << " px\n";
+
+	// Partly beyond the field of view, and partly behind the camera: drawn
+	// where visible, never fully visible, no crash.
+	for (const double bearing : {0.5, 1.2})
+	{
+		const Scene scene = makeScene(lm, levelCameraLookingAt(lm, 0.4, 0.2, 0.0, bearing), cam);
+		const Render r = render(scene, RenderOptions(), 3);
+		EXPECT_FALSE(r.truth[0].fully_visible) << "bearing " << bearing;
+	}
+	const Scene grazing = makeScene(lm, levelCameraLookingAt(lm, 0.05, 80 * kDeg, 0.0, -1.3), cam);
+	EXPECT_EQ(render(grazing, RenderOptions(), 1).image.size(), cv::Size(640, 480));
 }
 
 TEST(Render, PartlyOutsideIsNotFullyVisible)

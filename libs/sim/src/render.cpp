@@ -122,10 +122,10 @@ Polygon3 faceSquare(const Rigid& cam_T_lm, double half)
  * grown by \a grow px; empty when outside. */
 cv::Rect pixelBounds(const std::vector<Eigen::Vector2d>& pts, int width, int height, int grow)
 {
-	if (pts.empty()) return {};
-	double minx = pts[0].x(), maxx = minx, miny = pts[0].y(), maxy = miny;
+	double minx = 1e300, maxx = -1e300, miny = 1e300, maxy = -1e300;
 	for (const auto& p : pts)
 	{
+		if (!p.allFinite()) continue;
 		minx = std::min(minx, p.x());
 		maxx = std::max(maxx, p.x());
 		miny = std::min(miny, p.y());
@@ -224,6 +224,7 @@ struct CornerGrid
 	std::vector<double> key;  //!< the camera it belongs to
 	int width = 0;
 	std::vector<Eigen::Vector2d> xn;
+	double max_r2 = 0;  //!< largest |xn|^2 over the image: the field of view
 };
 
 /** The corner grid of \a cam, computed once and cached for the last camera
@@ -243,7 +244,11 @@ std::shared_ptr<const CornerGrid> cornerGrid(const CameraModel& cam)
 	g->xn.resize(static_cast<size_t>(g->width) * (cam.height() + 1));
 	for (int j = 0; j <= cam.height(); ++j)
 		for (int i = 0; i <= cam.width(); ++i)
-			g->xn[static_cast<size_t>(j) * g->width + i] = cam.undistortToNormalized({i - 0.5, j - 0.5});
+		{
+			const Eigen::Vector2d xn = cam.undistortToNormalized({i - 0.5, j - 0.5});
+			g->xn[static_cast<size_t>(j) * g->width + i] = xn;
+			g->max_r2 = std::max(g->max_r2, xn.squaredNorm());
+		}
 	cached = g;
 	return cached;
 }
@@ -255,19 +260,29 @@ void drawLandmarkSampled(
 	const RenderOptions& o, const CornerGrid* corners)
 {
 	// Bounds from the distorted projections of the (near-clipped) outlines.
+	// The lens model only holds inside the field of view (beyond it the
+	// polynomial may fold points back into the image), so an outline that
+	// leaves the field of view makes the whole image the region.
+	const CornerGrid& grid = *corners;
 	std::vector<Eigen::Vector2d> outline;
+	bool leaves_view = false;
 	const auto addOutline = [&](const Polygon3& poly) {
 		const Polygon3 p = detail::clipNear(poly, kNearM);
 		for (size_t i = 0; i < p.size(); ++i)
 			for (int k = 0; k < 64; ++k)
 			{
 				const Eigen::Vector3d q = p[i] + (p[(i + 1) % p.size()] - p[i]) * (k / 64.0);
-				if (auto px = cam.project(q)) outline.push_back(*px);
+				const Eigen::Vector2d xn(q.x() / q.z(), q.y() / q.z());
+				if (xn.squaredNorm() > grid.max_r2 * 1.21)
+					leaves_view = true;
+				else if (auto px = cam.project(q))
+					outline.push_back(*px);
 			}
 	};
 	addOutline(faceSquare(cam_T_lm, face.sheet_half));
 	if (face.has_occluder)
 		addOutline(faceRect(cam_T_lm, face.occ_s0, face.occ_t0, face.occ_s1, face.occ_t1));
+	if (leaves_view) outline = {{0.0, 0.0}, {img.cols - 1.0, img.rows - 1.0}};
 	const cv::Rect roi = pixelBounds(outline, img.cols, img.rows, 2);
 	if (roi.empty()) return;
 
@@ -277,7 +292,6 @@ void drawLandmarkSampled(
 	if (!(std::abs(M.determinant()) > 1e-15)) return;  // seen edge-on
 	const Eigen::Matrix3d Minv = M.inverse();
 
-	const CornerGrid& grid = *corners;
 	const int gw = grid.width;
 	const int n = o.supersampling;
 	const int nn = n * n;
@@ -382,9 +396,14 @@ LandmarkTruth truthOf(const MapLandmark& lm, const Scene& scene, Rigid* cam_T_lm
 		for (int k = 0; k < 16 && inside; ++k)
 		{
 			const Eigen::Vector2d f = oc[i] + (oc[(i + 1) % 4] - oc[i]) * (k / 16.0);
-			const auto px = cam.project(cam_T_lm * LandmarkGeometry::faceToLandmark(f.x(), f.y()));
+			const Eigen::Vector3d p = cam_T_lm * LandmarkGeometry::faceToLandmark(f.x(), f.y());
+			const auto px = cam.project(p);
 			inside = px && px->x() >= 0.5 && px->x() <= cam.width() - 1.5 && px->y() >= 0.5 &&
 				px->y() <= cam.height() - 1.5;
+			// Beyond the field of view a lens polynomial can fold points
+			// back into the image: such a pixel does not undistort back.
+			if (inside && cam.hasDistortion())
+				inside = (cam.undistortToNormalized(*px) - Eigen::Vector2d(p.x() / p.z(), p.y() / p.z())).norm() < 1e-6;
 		}
 	tr.fully_visible = inside;
 	tr.sighting = sightingTruth(tr.landmark_T_camera);
