@@ -287,6 +287,8 @@ TEST(Render, TruthMatchesTheScene)
 				EXPECT_NEAR(tr.sighting.L[2], a - bearing, 1e-9);
 				EXPECT_NEAR(tr.sighting.pose_in_landmark[0], d * std::cos(a), 1e-9);
 				EXPECT_NEAR(tr.sighting.pose_in_landmark[1], d * std::sin(a), 1e-9);
+				EXPECT_NEAR(std::atan2(tr.sighting.pose_in_landmark[1], tr.sighting.pose_in_landmark[0]),
+							tr.sighting.L[1] + tr.sighting.L[2], 1e-9);
 				EXPECT_NEAR(tr.landmark_T_camera.z(), height, 1e-9);
 				// Corners: the camera model on the reference points.
 				const auto ref = lm.geometry().referencePoints();

@@ -32,12 +32,16 @@ enum class Background
 struct RenderOptions : public mrpt::config::CLoadableOptions
 {
 	Background background = Background::Flat;
-	double background_grey = 128;  //!< Flat background level [0..255]
-	int distractors = 0;  //!< number of distractor shapes with Cluttered
+	double background_grey = 128;  //!< Flat background level, mean of the texture [0..255]
+	/** Number of distractor shapes with Cluttered (green blobs and
+	 * rectangles, black frames filled with red, blue, white or grey,
+	 * posters with black and green print, marker-like grids), drawn under
+	 * the landmarks. */
+	int distractors = 0;
 
 	/** Colours at gain 1, BGR [0..255]. Black is printed black, not 0. */
 	cv::Scalar black_bgr{25, 25, 25};
-	cv::Scalar white_bgr{235, 235, 235};
+	cv::Scalar white_bgr{235, 235, 235};  //!< the sheet's white (quiet margin)
 	cv::Scalar green_bgr{0, 255, 0};  //!< fluorescent green: sRGB #00FF00
 
 	double gain = 1.0;  //!< illumination gain (multiplies all intensities)
@@ -144,12 +148,14 @@ const char* backgroundName(Background b);
  * std::invalid_argument otherwise. */
 Background backgroundFromName(const std::string& name);
 
-/** A level camera (optical axis horizontal, no roll) at distance
- * \a distance_m from \a landmark's centre, seen at \a view_angle_rad between
+/** A level camera (optical axis horizontal, no roll) at horizontal distance
+ * \a distance_m [m] from \a landmark's centre, seen at \a view_angle_rad between
  * the line of sight and the landmark's outward normal (counter-clockwise
  * positive, seen from above), at \a height_m above the landmark centre,
  * turned so that the landmark centre appears \a bearing_rad left of the
- * optical axis (phi1). Returns world_T_camera (optical frame). */
+ * optical axis (phi1). The optical centre is at (d cos a, d sin a, h) in
+ * frame L, so sightingTruth() gives L = (d, bearing, a - bearing). Returns
+ * world_T_camera (optical frame). */
 mrpt::poses::CPose3D levelCameraLookingAt(
 	const MapLandmark& landmark, double distance_m, double view_angle_rad,
 	double height_m = 0.0, double bearing_rad = 0.0);
