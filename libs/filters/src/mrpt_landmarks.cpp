@@ -1,0 +1,101 @@
+#include <codemark/filters/mrpt_landmarks.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace codemark::filters
+{
+namespace
+{
+constexpr std::size_t kColumns = 7;
+
+// The tokens of one line with comments ('%' or '#' to the end) removed.
+std::vector<std::string> tokens(std::string text)
+{
+	if (const auto c = text.find_first_of("%#"); c != std::string::npos) text.erase(c);
+	std::istringstream ss(text);
+	std::vector<std::string> tok;
+	for (std::string t; ss >> t;) tok.push_back(t);
+	return tok;
+}
+
+// A whole-token finite number, else MapFileError naming the column.
+double number(const std::string& tok, const char* field, const std::string& name, int line)
+{
+	std::size_t used = 0;
+	double v = 0;
+	try
+	{
+		v = std::stod(tok, &used);
+	}
+	catch (const std::exception&)
+	{
+		used = 0;
+	}
+	if (used == 0 || used != tok.size())
+		throw MapFileError(
+			name, line, std::string("column '") + field + "' is not a number: '" + tok + "'");
+	if (!std::isfinite(v))
+		throw MapFileError(
+			name, line, std::string("column '") + field + "' is not finite: '" + tok + "'");
+	return v;
+}
+}  // namespace
+
+LandmarkMap parseMrptLandmarks(std::istream& in, const std::string& name)
+{
+	static const char* kFields[kColumns] = {"x", "y", "z", "type", "unused", "unused", "id"};
+	LandmarkMap map;
+	std::set<int> seen;
+	std::string text;
+	int line = 0;
+	while (std::getline(in, text))
+	{
+		++line;
+		const auto tok = tokens(text);
+		if (tok.empty()) continue;
+		if (tok.size() != kColumns)
+			throw MapFileError(
+				name, line,
+				"expected 7 columns 'x y z type 0 0 id' (MRPT landmark ground truth), found " +
+					std::to_string(tok.size()));
+		double v[kColumns];
+		for (std::size_t i = 0; i < kColumns; ++i) v[i] = number(tok[i], kFields[i], name, line);
+		const double id = v[6];
+		if (id != std::floor(id) || id < 0 || id > 2147483647.0)
+			throw MapFileError(name, line, "ID '" + tok[6] + "' is not a non-negative integer");
+		MapLandmark l;
+		l.id = static_cast<int>(id);
+		l.x_m = v[0];
+		l.y_m = v[1];
+		l.z_m = v[2];
+		if (!seen.insert(l.id).second)
+			throw MapFileError(name, line, "duplicate ID " + std::to_string(l.id));
+		map.landmarks.push_back(l);
+	}
+	return map;
+}
+
+LandmarkMap loadMrptLandmarksFile(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error("cannot open MRPT landmark file '" + path + "'");
+	return parseMrptLandmarks(f, path);
+}
+
+bool isMrptLandmarksFile(const std::string& path)
+{
+	std::ifstream f(path);
+	for (std::string text; std::getline(f, text);)
+	{
+		const auto tok = tokens(text);
+		if (!tok.empty()) return tok.size() == kColumns;
+	}
+	return false;
+}
+
+}  // namespace codemark::filters
