@@ -600,3 +600,34 @@ TEST(Render, NearerLandmarksCoverFartherOnes)
 			EXPECT_EQ(v[1] < 128, row == 1 && col == 1) << "cell " << row << col;
 		}
 }
+
+TEST(Render, SampledPathAgreesWithExactCoverage)
+{
+	// A negligible distortion switches to the supersampled path; the image
+	// must match the exact-coverage one up to the sampling error.
+	mrpt::img::TCamera p = CameraModel().params();
+	p.distortion = mrpt::img::DistortionModel::plumb_bob;
+	p.dist.fill(0);
+	p.dist[0] = 1e-12;
+	const CameraModel sampled(p), exact;
+	ASSERT_TRUE(sampled.hasDistortion());
+	const MapLandmark lm = makeLandmark(170);
+	RenderOptions o;
+	o.occlusion = 0.3;
+	const CPose3D pose = levelCameraLookingAt(lm, 1.3, 35 * kDeg, 0.1, 0.05);
+	const cv::Mat a = render(makeScene(lm, pose, exact), o, 4).image;
+	const cv::Mat b = render(makeScene(lm, pose, sampled), o, 4).image;
+	cv::Mat diff;
+	cv::absdiff(a, b, diff);
+	// 64 samples per pixel: a pixel's coverage is off by at most 1/64 of a
+	// 255 contrast along straight edges (more only at corners).
+	EXPECT_LT(cv::mean(diff)[1], 0.05);
+	double worst = 0;
+	cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+	EXPECT_LT(worst, 40.0);
+	const int differ = cv::countNonZero(diff.reshape(1) > 0), big = cv::countNonZero(diff.reshape(1) > 8);
+	std::cout << "sampled vs exact: mean " << cv::mean(diff)[1] << ", worst " << worst << " grey levels, "
+			  << big << " of " << differ << " differing values above 8\n";
+	EXPECT_GT(differ, 0);  // the two paths really differ (the sampled one ran)
+	EXPECT_LT(big, differ / 10);
+}

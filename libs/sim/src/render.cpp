@@ -216,8 +216,9 @@ void drawLandmarkExact(
 /** Undistorted normalised coordinates of every pixel corner of the image:
  * xn[j * width + i] is corner (i - 0.5, j - 0.5), width = image width + 1.
  * Samples inside a pixel interpolate its four corners bilinearly: the
- * distortion is smooth, so the interpolation error (about 1e-3 px for
- * |k1| = 0.3 at 800 px focal length) is far below the sampling error, and it
+ * distortion is smooth, so the interpolation error (h^2/8 times its second
+ * derivative: about 1e-4 px for |k1| = 0.3 at 800 px focal length) is far
+ * below the sampling error, and it
  * saves n^2 iterative inversions per pixel. */
 struct CornerGrid
 {
