@@ -1,0 +1,163 @@
+// Stage 8: frame verification and the code.
+#include "stages.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace codemark::detect
+{
+Eigen::Matrix3d faceToImage(const Quad& c)
+{
+	// Four-point DLT with h33 = 1 (the reference square is never degenerate
+	// here: linkQuadrangle checked convexity).
+	const double src[4][2] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
+	Eigen::Matrix<double, 8, 8> A;
+	Eigen::Matrix<double, 8, 1> b;
+	for (int k = 0; k < 4; ++k)
+	{
+		const double x = src[k][0], y = src[k][1], u = c[k].x(), v = c[k].y();
+		A.row(2 * k) << x, y, 1, 0, 0, 0, -u * x, -u * y;
+		A.row(2 * k + 1) << 0, 0, 0, x, y, 1, -v * x, -v * y;
+		b(2 * k) = u;
+		b(2 * k + 1) = v;
+	}
+	const Eigen::Matrix<double, 8, 1> h = A.partialPivLu().solve(b);
+	Eigen::Matrix3d H;
+	H << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1.0;
+	return H;
+}
+
+std::optional<double> sampleG(const cv::Mat& bgr, double u, double v)
+{
+	if (!(u >= 0 && v >= 0 && u <= bgr.cols - 1 && v <= bgr.rows - 1)) return std::nullopt;
+	const int x0 = std::min(static_cast<int>(u), bgr.cols - 2 < 0 ? 0 : bgr.cols - 2);
+	const int y0 = std::min(static_cast<int>(v), bgr.rows - 2 < 0 ? 0 : bgr.rows - 2);
+	const int x1 = std::min(x0 + 1, bgr.cols - 1), y1 = std::min(y0 + 1, bgr.rows - 1);
+	const double fx = u - x0, fy = v - y0;
+	const uint8_t* r0 = bgr.ptr<uint8_t>(y0);
+	const uint8_t* r1 = bgr.ptr<uint8_t>(y1);
+	const double top = (1 - fx) * r0[3 * x0 + 1] + fx * r0[3 * x1 + 1];
+	const double bot = (1 - fx) * r1[3 * x0 + 1] + fx * r1[3 * x1 + 1];
+	return (1 - fy) * top + fy * bot;
+}
+
+namespace
+{
+/** Maps normalised face coordinates to raw pixels. */
+struct FaceMap
+{
+	Eigen::Matrix3d H;
+	const CameraModel& cam;
+	bool distorted;
+
+	Eigen::Vector2d operator()(double x, double y) const
+	{
+		const Eigen::Vector3d q = H * Eigen::Vector3d(x, y, 1);
+		const Eigen::Vector2d ideal = q.head<2>() / q.z();
+		if (!distorted) return ideal;
+		return cam.distortNormalized(
+			{(ideal.x() - cam.cx()) / cam.fx(), (ideal.y() - cam.cy()) / cam.fy()});
+	}
+};
+
+/** Mean G over a square patch of half-size \a r centred on (x, y) in
+ * normalised face coordinates, on a 5 x 5 grid; nullopt if outside. */
+std::optional<double> patchMean(const cv::Mat& bgr, const FaceMap& map, double x, double y, double rx, double ry)
+{
+	double s = 0;
+	for (int i = -2; i <= 2; ++i)
+		for (int j = -2; j <= 2; ++j)
+		{
+			const Eigen::Vector2d px = map(x + rx * j / 2.0, y + ry * i / 2.0);
+			const auto g = sampleG(bgr, px.x(), px.y());
+			if (!g) return std::nullopt;
+			s += *g;
+		}
+	return s / 25;
+}
+}  // namespace
+
+std::optional<CodeReading> readCode(
+	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& cam, const LandmarkGeometry& geo,
+	const CodeParams& p)
+{
+	const FaceMap map{faceToImage(q.corners_ideal), cam, cam.hasDistortion()};
+	const double h = geo.innerHalf();
+	// The whole outer frame must be in the image: a landmark cut by the
+	// border is not reported.
+	const double outer = geo.outerHalf() / h;
+	const double lo_u = p.border_px - 0.5, hi_u = bgr.cols - 0.5 - p.border_px;
+	const double lo_v = p.border_px - 0.5, hi_v = bgr.rows - 0.5 - p.border_px;
+	for (int k = 0; k < 8; ++k)
+	{
+		// Corners and side midpoints of the outer edge (distortion bends it).
+		const double xs[8] = {-1, 0, 1, 1, 1, 0, -1, -1}, ys[8] = {1, 1, 1, 0, -1, -1, -1, 0};
+		const Eigen::Vector2d px = map(outer * xs[k], outer * ys[k]);
+		if (!(px.x() >= lo_u && px.x() <= hi_u && px.y() >= lo_v && px.y() <= hi_v)) return std::nullopt;
+	}
+	// References: the black frame, midway between its inner and outer edge,
+	// and the green ring between the code board and the frame, side by
+	// side (top, right, bottom, left).
+	const double rb = 0.5 * (1 + outer);
+	const double board = 1.5 * geo.cell_size_m / h;
+	const double rg = 0.5 * (board + 1);
+	const double band_b = 0.25 * (outer - 1), band_g = 0.25 * (1 - board);
+	std::array<double, 4> black{}, green{};
+	const double dirs[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+	for (int side = 0; side < 4; ++side)
+	{
+		double sb = 0, sg = 0;
+		const int n = 3;
+		for (int k = 0; k < n; ++k)
+		{
+			const double t = -0.5 + 0.5 * k;  // along the side, within its middle
+			const double nx = dirs[side][0], ny = dirs[side][1];
+			// Along-side direction is (ny, -nx).
+			const double ax = ny * t, ay = -nx * t;
+			const double rx_b = nx != 0 ? band_b : 0.08, ry_b = ny != 0 ? band_b : 0.08;
+			const double rx_g = nx != 0 ? band_g : 0.08, ry_g = ny != 0 ? band_g : 0.08;
+			const auto b = patchMean(bgr, map, nx * rb + ax, ny * rb + ay, rx_b, ry_b);
+			const auto g = patchMean(bgr, map, nx * rg + ax * rg, ny * rg + ay * rg, rx_g, ry_g);
+			if (!b || !g) return std::nullopt;
+			sb += *b;
+			sg += *g;
+		}
+		black[side] = sb / n;
+		green[side] = sg / n;
+	}
+	CodeReading r;
+	r.green_g = 0.25 * (green[0] + green[1] + green[2] + green[3]);
+	// The two darkest frame sides: at an oblique view the foreshortened
+	// sides are thin and blur towards their neighbours.
+	std::array<double, 4> sorted = black;
+	std::sort(sorted.begin(), sorted.end());
+	r.black_g = 0.5 * (sorted[0] + sorted[1]);
+	const double contrast = r.green_g - r.black_g;
+	if (contrast < p.min_contrast) return std::nullopt;
+	for (int side = 0; side < 4; ++side)
+		if (black[side] > p.max_black_ratio * green[side] ||
+			green[side] < r.black_g + 0.5 * contrast)
+			return std::nullopt;
+	const double thr = 0.5 * (r.green_g + r.black_g);
+	const double cell = geo.cell_size_m / h;
+	const double pr = 0.5 * p.patch_fraction * cell;
+	r.margin = contrast;
+	for (int row = 0; row < 3; ++row)
+		for (int col = 0; col < 3; ++col)
+		{
+			const Eigen::Vector2d f = geo.cellCentreFace(row, col) / h;
+			const auto g = patchMean(bgr, map, f.x(), f.y(), pr, pr);
+			if (!g) return std::nullopt;
+			r.cell_g[3 * row + col] = *g;
+			r.cells[row][col] = *g < thr;
+			r.margin = std::min(r.margin, std::abs(*g - thr));
+		}
+	if (r.margin < p.min_margin * contrast) return std::nullopt;
+	const auto id = decodeCells(r.cells);
+	if (!id) return std::nullopt;
+	r.id = *id;
+	return r;
+}
+
+}  // namespace codemark::detect

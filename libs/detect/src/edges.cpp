@@ -1,0 +1,210 @@
+// Stages 4-6: edgels and their domains, side selection, quadrangle linking.
+#include "stages.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace codemark::detect
+{
+double gradientThreshold(double fill_g, const EdgelParams& p)
+{
+	return std::max(p.min_gradient, p.rel_gradient * fill_g);
+}
+
+EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold, const EdgelParams& p)
+{
+	EdgelMap m;
+	m.roi = roi_in & cv::Rect(0, 0, bgr.cols, bgr.rows);
+	m.threshold = threshold;
+	if (m.roi.width < 3 || m.roi.height < 3) return m;
+	cv::Mat g, gx, gy;
+	cv::extractChannel(bgr(m.roi), g, 1);
+	cv::Sobel(g, gx, CV_16S, 1, 0, 3, 1, 0, cv::BORDER_REPLICATE);
+	cv::Sobel(g, gy, CV_16S, 0, 1, 3, 1, 0, cv::BORDER_REPLICATE);
+	// The 3x3 Sobel answers 8 per grey level per pixel of slope.
+	const int t = static_cast<int>(std::ceil(8 * threshold));
+	const int t2 = t * t;
+	const int W = m.roi.width, H = m.roi.height;
+	m.polarity = cv::Mat::zeros(H, W, CV_8UC1);
+	for (int y = 1; y < H - 1; ++y)
+	{
+		const short* ax = gx.ptr<short>(y);
+		const short* ay = gy.ptr<short>(y);
+		const short* ay_up = gy.ptr<short>(y - 1);
+		const short* ay_dn = gy.ptr<short>(y + 1);
+		uint8_t* pol = m.polarity.ptr<uint8_t>(y);
+		for (int x = 1; x < W - 1; ++x)
+		{
+			const int dx = ax[x], dy = ay[x];
+			if (dx * dx + dy * dy < t2) continue;
+			// Non-maximum suppression along the dominant gradient axis, on
+			// the signed component (keeps the two edges of a thin bar apart).
+			if (std::abs(dx) >= std::abs(dy))
+			{
+				const int s = dx > 0 ? 1 : -1;
+				if (s * dx < s * ax[x - 1] || s * dx <= s * ax[x + 1]) continue;
+				pol[x] = static_cast<uint8_t>(dx > 0 ? Polarity::Left : Polarity::Right);
+			}
+			else
+			{
+				const int s = dy > 0 ? 1 : -1;
+				if (s * dy < s * ay_up[x] || s * dy <= s * ay_dn[x]) continue;
+				pol[x] = static_cast<uint8_t>(dy > 0 ? Polarity::Top : Polarity::Bottom);
+			}
+		}
+	}
+	// Edgel domains: 8-connected flood fill over edgels of one polarity
+	// (hand-written: cv::connectedComponents would need one pass per
+	// polarity and still no second-order moments).
+	cv::Mat seen = cv::Mat::zeros(H, W, CV_8UC1);
+	std::vector<cv::Point> pts;
+	pts.reserve(256);
+	for (int y = 1; y < H - 1; ++y)
+	{
+		const uint8_t* pol = m.polarity.ptr<uint8_t>(y);
+		for (int x = 1; x < W - 1; ++x)
+		{
+			if (!pol[x] || seen.at<uint8_t>(y, x)) continue;
+			const uint8_t cls = pol[x];
+			pts.clear();
+			pts.emplace_back(x, y);
+			seen.at<uint8_t>(y, x) = 1;
+			for (size_t k = 0; k < pts.size(); ++k)
+			{
+				const cv::Point q = pts[k];
+				for (int oy = -1; oy <= 1; ++oy)
+					for (int ox = -1; ox <= 1; ++ox)
+					{
+						const int xx = q.x + ox, yy = q.y + oy;
+						if (xx < 1 || yy < 1 || xx >= W - 1 || yy >= H - 1) continue;
+						if (m.polarity.at<uint8_t>(yy, xx) != cls || seen.at<uint8_t>(yy, xx)) continue;
+						seen.at<uint8_t>(yy, xx) = 1;
+						pts.emplace_back(xx, yy);
+					}
+			}
+			if (static_cast<int>(pts.size()) < p.min_edgels) continue;
+			EdgelDomain d;
+			d.polarity = static_cast<Polarity>(cls);
+			d.count = static_cast<int>(pts.size());
+			Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+			for (const auto& q : pts) mean += Eigen::Vector2d(q.x, q.y);
+			mean /= d.count;
+			Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+			for (const auto& q : pts)
+			{
+				const Eigen::Vector2d e = Eigen::Vector2d(q.x, q.y) - mean;
+				cov += e * e.transpose();
+			}
+			cov /= d.count;
+			Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+			d.dir = es.eigenvectors().col(1);
+			d.width_px = std::sqrt(std::max(0.0, es.eigenvalues()(0)));
+			double tmin = std::numeric_limits<double>::max(), tmax = -tmin;
+			for (const auto& q : pts)
+			{
+				const double tt = d.dir.dot(Eigen::Vector2d(q.x, q.y) - mean);
+				tmin = std::min(tmin, tt);
+				tmax = std::max(tmax, tt);
+			}
+			const Eigen::Vector2d off(m.roi.x, m.roi.y);
+			d.mean = mean + off;
+			d.end0 = d.mean + tmin * d.dir;
+			d.end1 = d.mean + tmax * d.dir;
+			d.length_px = tmax - tmin + 1;
+			m.domains.push_back(d);
+		}
+	}
+	return m;
+}
+
+std::optional<SideSegments> selectSegments(
+	const std::vector<EdgelDomain>& domains, const Candidate& c, const SegmentParams& p)
+{
+	SideSegments out;
+	const Polarity order[4] = {Polarity::Top, Polarity::Right, Polarity::Bottom, Polarity::Left};
+	for (int k = 0; k < 4; ++k)
+	{
+		const Polarity pol = order[k];
+		const bool vertical_side = pol == Polarity::Left || pol == Polarity::Right;
+		const double extent = vertical_side ? c.bbox.height : c.bbox.width;
+		// The side lies on the far side of the centroid along the gradient:
+		// left of it for the left edge, etc.
+		const int axis = vertical_side ? 0 : 1;
+		const double sign = (pol == Polarity::Left || pol == Polarity::Top) ? -1.0 : 1.0;
+		const EdgelDomain* best = nullptr;
+		double best_dist = std::numeric_limits<double>::max();
+		for (const auto& d : domains)
+		{
+			if (d.polarity != pol) continue;
+			if (d.width_px > p.max_width_px) continue;
+			if (d.length_px < p.min_rel_length * extent) continue;
+			// Along the side: a vertical side's direction is mostly vertical.
+			if (std::abs(d.dir(1 - axis)) < std::abs(d.dir(axis))) continue;
+			const double dist = sign * (d.mean(axis) - c.centroid(axis));
+			if (dist <= 0) continue;
+			if (dist < best_dist)
+			{
+				best_dist = dist;
+				best = &d;
+			}
+		}
+		if (!best) return std::nullopt;
+		out[k] = *best;
+	}
+	return out;
+}
+
+namespace
+{
+std::optional<Eigen::Vector2d> intersect(const EdgelDomain& a, const EdgelDomain& b)
+{
+	// a.mean + s a.dir = b.mean + t b.dir
+	Eigen::Matrix2d A;
+	A << a.dir, -b.dir;
+	if (std::abs(A.determinant()) < 1e-3) return std::nullopt;
+	const Eigen::Vector2d st = A.inverse() * (b.mean - a.mean);
+	return a.mean + st(0) * a.dir;
+}
+
+double nearestEnd(const EdgelDomain& d, const Eigen::Vector2d& q)
+{
+	return std::min((d.end0 - q).norm(), (d.end1 - q).norm());
+}
+}  // namespace
+
+std::optional<Quad> linkQuadrangle(const SideSegments& s, const QuadParams& p)
+{
+	// Sides: 0 top, 1 right, 2 bottom, 3 left; corner k joins sides k-1 and k
+	// (TL = left x top, TR = top x right, ...).
+	Quad q;
+	const int prev[4] = {3, 0, 1, 2};
+	for (int k = 0; k < 4; ++k)
+	{
+		const auto c = intersect(s[prev[k]], s[k]);
+		if (!c) return std::nullopt;
+		q[k] = *c;
+	}
+	double perimeter = 0;
+	for (int k = 0; k < 4; ++k)
+	{
+		const double side = (q[(k + 1) % 4] - q[k]).norm();
+		if (side < p.min_side_px) return std::nullopt;
+		perimeter += side;
+	}
+	const double gap = std::max(p.max_gap_px, p.max_gap_rel * perimeter / 4);
+	for (int k = 0; k < 4; ++k)
+		if (nearestEnd(s[prev[k]], q[k]) > gap || nearestEnd(s[k], q[k]) > gap) return std::nullopt;
+	// Convex and clockwise in the image (v down): TL -> TR -> BR -> BL.
+	for (int k = 0; k < 4; ++k)
+	{
+		const Eigen::Vector2d a = q[(k + 1) % 4] - q[k], b = q[(k + 2) % 4] - q[(k + 1) % 4];
+		if (a.x() * b.y() - a.y() * b.x() <= 0) return std::nullopt;
+	}
+	return q;
+}
+
+}  // namespace codemark::detect

@@ -1,0 +1,292 @@
+// Stages 1-3: smoothing, colour segmentation, connected components.
+#include "stages.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace codemark::detect
+{
+namespace
+{
+/** The HSI predicate in integer arithmetic on channel sums of n pixels, so
+ * that the hot loop has no division and no float conversion. */
+struct FillPredicate
+{
+	int min_sum;  // 3 * t_I * n
+	int sat_num;  // saturation: 3 * min * 1024 <= sat_num * sum
+	int hue_lo, hue_hi;  // hue band: hue_lo * (G - min) <= 960 * (B - R) <= hue_hi * (G - min)
+
+	FillPredicate(const SegmentationParams& p, int n)
+		: min_sum(static_cast<int>(std::ceil(3.0 * p.min_intensity * n))),
+		  sat_num(static_cast<int>(std::lround(1024.0 * (1.0 - p.min_saturation)))),
+		  hue_lo(static_cast<int>(std::lround(16.0 * (p.hue_min_deg - 120.0)))),
+		  hue_hi(static_cast<int>(std::lround(16.0 * (p.hue_max_deg - 120.0))))
+	{
+	}
+
+	bool operator()(int r, int g, int b) const
+	{
+		// HSI hue in [60, 180] deg (hexcone form) needs G to be the largest
+		// channel; then hue = 120 + 60 (B - R) / (G - min).
+		const int sum = r + g + b;
+		const int mn = std::min(r, b);
+		const int chroma = g - mn;
+		const int hue = 960 * (b - r);
+		return (sum >= min_sum) & (g > r) & (g > b) & (3 * 1024 * mn <= sat_num * sum) &
+			(hue >= hue_lo * chroma) & (hue <= hue_hi * chroma);
+	}
+};
+
+/** The predicate tabulated on 32 levels per channel (32 KiB, L1-resident):
+ * one table look-up per grid cell instead of the arithmetic. Built once per
+ * parameter set and thread. */
+const std::vector<uint8_t>& fillTable(const SegmentationParams& p)
+{
+	thread_local std::vector<uint8_t> table;
+	thread_local double key[4] = {-1, -1, -1, -1};
+	const double k[4] = {p.min_intensity, p.hue_min_deg, p.hue_max_deg, p.min_saturation};
+	if (table.empty() || !std::equal(k, k + 4, key))
+	{
+		const FillPredicate pred(p, 1);
+		table.assign(1 << 15, 0);
+		for (int r = 0; r < 32; ++r)
+			for (int g = 0; g < 32; ++g)
+				for (int b = 0; b < 32; ++b)
+					table[(r << 10) | (g << 5) | b] = pred(8 * r + 4, 8 * g + 4, 8 * b + 4) ? 255 : 0;
+		std::copy(k, k + 4, key);
+	}
+	return table;
+}
+
+template <int S, bool Box>
+void segmentGrid(const cv::Mat& bgr, cv::Mat& mask, const uint8_t* table)
+{
+	// Box: mean of the S x S block, as a fixed-point multiply.
+	constexpr int kInv = 65536 / (S * S);
+	for (int i = 0; i < mask.rows; ++i)
+	{
+		uint8_t* out = mask.ptr<uint8_t>(i);
+		const uint8_t* rows[S];
+		for (int k = 0; k < S; ++k) rows[k] = bgr.ptr<uint8_t>(i * S + k);
+		for (int j = 0; j < mask.cols; ++j)
+		{
+			int b = 0, g = 0, r = 0;
+			if constexpr (Box)
+			{
+				for (int k = 0; k < S; ++k)
+					for (int l = 0; l < S; ++l)
+					{
+						const uint8_t* px = rows[k] + 3 * (j * S + l);
+						b += px[0];
+						g += px[1];
+						r += px[2];
+					}
+				b = (b * kInv) >> 16;
+				g = (g * kInv) >> 16;
+				r = (r * kInv) >> 16;
+			}
+			else
+			{
+				const uint8_t* px = rows[0] + 3 * j * S;
+				b = px[0];
+				g = px[1];
+				r = px[2];
+			}
+			out[j] = table[((r >> 3) << 10) | ((g >> 3) << 5) | (b >> 3)];
+		}
+	}
+}
+}  // namespace
+
+bool isFillColour(double r, double g, double b, const SegmentationParams& p)
+{
+	// The table the segmentation uses, so that tests see the same answer.
+	const auto q = [](double v) { return std::clamp(static_cast<int>(std::lround(v)), 0, 255) >> 3; };
+	return fillTable(p)[(q(r) << 10) | (q(g) << 5) | q(b)] != 0;
+}
+
+cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
+{
+	if (bgr.type() != CV_8UC3) throw std::invalid_argument("segmentColour: expected a CV_8UC3 image");
+	const int s = p.step_px;
+	if (s < 1 || s > 4) throw std::invalid_argument("segmentColour: step_px must be 1..4");
+	cv::Mat mask(bgr.rows / s, bgr.cols / s, CV_8UC1);
+	if (mask.empty()) return mask;
+	const uint8_t* pred = fillTable(p).data();
+	// Dispatch to a loop specialised for the step, so the block sums unroll.
+	switch (s * 2 + (p.box_smoothing ? 1 : 0))
+	{
+		case 2: case 3: segmentGrid<1, false>(bgr, mask, pred); break;
+		case 4: segmentGrid<2, false>(bgr, mask, pred); break;
+		case 5: segmentGrid<2, true>(bgr, mask, pred); break;
+		case 6: segmentGrid<3, false>(bgr, mask, pred); break;
+		case 7: segmentGrid<3, true>(bgr, mask, pred); break;
+		case 8: segmentGrid<4, false>(bgr, mask, pred); break;
+		default: segmentGrid<4, true>(bgr, mask, pred); break;
+	}
+	return mask;
+}
+
+namespace
+{
+/** A horizontal run of mask cells [x0, x1) in row y. */
+struct Run
+{
+	int y, x0, x1;
+	int parent;  // union-find
+};
+
+int findRoot(std::vector<Run>& runs, int i)
+{
+	while (runs[i].parent != i)
+	{
+		runs[i].parent = runs[runs[i].parent].parent;  // path halving
+		i = runs[i].parent;
+	}
+	return i;
+}
+
+struct Moments
+{
+	double m0 = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sg = 0;
+	int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;  // inclusive bbox
+};
+
+inline double sumSquares(double k) { return k * (k + 1) * (2 * k + 1) / 6; }  // 0^2 + ... + k^2
+}  // namespace
+
+std::vector<Candidate> findCandidates(
+	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p, cv::Mat* labels_out,
+	int* num_components)
+{
+	// N4-connected components by runs and union-find, hand-written because
+	// the moments up to second order then come per run in closed form, and a
+	// mostly empty mask costs one word-wise scan (cv::connectedComponentsWithStats
+	// gives no second moments and labels every cell).
+	std::vector<Candidate> out;
+	std::vector<Run> runs;
+	runs.reserve(1024);
+	size_t prev_begin = 0, prev_end = 0;
+	for (int y = 0; y < mask.rows; ++y)
+	{
+		const uint8_t* m = mask.ptr<uint8_t>(y);
+		const size_t cur_begin = runs.size();
+		int x = 0;
+		while (x < mask.cols)
+		{
+			// Skip empty cells eight at a time.
+			while (x + 8 <= mask.cols)
+			{
+				uint64_t w;
+				std::memcpy(&w, m + x, 8);
+				if (w) break;
+				x += 8;
+			}
+			while (x < mask.cols && !m[x]) ++x;
+			if (x >= mask.cols) break;
+			const int x0 = x;
+			while (x < mask.cols && m[x]) ++x;
+			runs.push_back({y, x0, x, static_cast<int>(runs.size())});
+		}
+		// Union with overlapping runs of the previous row (N4: shared columns).
+		size_t j = prev_begin;
+		for (size_t i = cur_begin; i < runs.size(); ++i)
+		{
+			while (j < prev_end && runs[j].x1 <= runs[i].x0) ++j;
+			for (size_t k = j; k < prev_end && runs[k].x0 < runs[i].x1; ++k)
+			{
+				const int a = findRoot(runs, static_cast<int>(i)), b = findRoot(runs, static_cast<int>(k));
+				if (a != b) runs[std::max(a, b)].parent = std::min(a, b);
+			}
+		}
+		prev_begin = cur_begin;
+		prev_end = runs.size();
+	}
+	// Moments per component.
+	std::vector<int> comp_of_root(runs.size(), -1);
+	std::vector<Moments> comps;
+	std::vector<int> run_comp(runs.size());
+	for (size_t i = 0; i < runs.size(); ++i)
+	{
+		const int r = findRoot(runs, static_cast<int>(i));
+		if (comp_of_root[r] < 0)
+		{
+			comp_of_root[r] = static_cast<int>(comps.size());
+			comps.emplace_back();
+		}
+		run_comp[i] = comp_of_root[r];
+		Moments& mo = comps[comp_of_root[r]];
+		const Run& u = runs[i];
+		const double n = u.x1 - u.x0, y = u.y;
+		const double sx = n * (u.x0 + u.x1 - 1) / 2;
+		mo.m0 += n;
+		mo.sx += sx;
+		mo.sy += n * y;
+		mo.sxx += sumSquares(u.x1 - 1) - sumSquares(u.x0 - 1);
+		mo.sxy += sx * y;
+		mo.syy += n * y * y;
+		mo.x0 = std::min(mo.x0, u.x0);
+		mo.x1 = std::max(mo.x1, u.x1 - 1);
+		mo.y0 = std::min(mo.y0, u.y);
+		mo.y1 = std::max(mo.y1, u.y);
+	}
+	if (num_components) *num_components = static_cast<int>(comps.size());
+	if (labels_out)
+	{
+		*labels_out = cv::Mat::zeros(mask.size(), CV_32S);
+		for (size_t i = 0; i < runs.size(); ++i)
+			labels_out->row(runs[i].y).colRange(runs[i].x0, runs[i].x1).setTo(run_comp[i] + 1);
+	}
+	const double cell_area = double(step) * step;
+	const double max_area = p.max_area_fraction * double(bgr.rows) * bgr.cols;
+	std::vector<char> keep(comps.size(), 0);
+	for (size_t l = 0; l < comps.size(); ++l)
+	{
+		const Moments& mo = comps[l];
+		const double area = mo.m0 * cell_area;
+		if (area < p.min_area_px || area > max_area) continue;
+		const double m0 = mo.m0, mx = mo.sx / m0, my = mo.sy / m0;
+		// Central moments per unit mass, with the 1/12 of each unit cell (a
+		// cell is a square, not a point).
+		const double mu20 = mo.sxx / m0 - mx * mx + 1.0 / 12, mu02 = mo.syy / m0 - my * my + 1.0 / 12;
+		const double mu11 = mo.sxy / m0 - mx * my;
+		Candidate c;
+		c.label = static_cast<int>(l) + 1;
+		c.compactness = (mu20 + mu02) / m0;  // (mu20 + mu02) / m00^2 for raw sums
+		const double tr = mu20 + mu02, det = mu20 * mu02 - mu11 * mu11;
+		const double disc = std::sqrt(std::max(0.0, tr * tr / 4 - det));
+		const double l1 = tr / 2 + disc, l2 = std::max(tr / 2 - disc, 1e-9);
+		c.elongation = std::sqrt(l1 / l2);
+		if (c.compactness > p.max_compactness || c.elongation > p.max_elongation) continue;
+		c.area_px = area;
+		c.bbox = cv::Rect(mo.x0 * step, mo.y0 * step, (mo.x1 - mo.x0 + 1) * step, (mo.y1 - mo.y0 + 1) * step);
+		c.centroid = {mx * step + 0.5 * (step - 1), my * step + 0.5 * (step - 1)};
+		const int gx = static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.width)) + p.roi_grow_px;
+		const int gy = static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.height)) + p.roi_grow_px;
+		c.roi = cv::Rect(c.bbox.x - gx, c.bbox.y - gy, c.bbox.width + 2 * gx, c.bbox.height + 2 * gy) &
+			cv::Rect(0, 0, bgr.cols, bgr.rows);
+		out.push_back(c);
+		keep[l] = 1;
+	}
+	// Mean G of each survivor's fill (for the gradient threshold).
+	if (!out.empty())
+	{
+		std::vector<double> sg(comps.size(), 0);
+		for (size_t i = 0; i < runs.size(); ++i)
+		{
+			if (!keep[run_comp[i]]) continue;
+			const uint8_t* px = bgr.ptr<uint8_t>(runs[i].y * step);
+			for (int x = runs[i].x0; x < runs[i].x1; ++x) sg[run_comp[i]] += px[3 * x * step + 1];
+		}
+		for (auto& c : out) c.fill_g = sg[c.label - 1] / comps[c.label - 1].m0;
+	}
+	std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.area_px > b.area_px; });
+	if (static_cast<int>(out.size()) > p.max_candidates) out.resize(p.max_candidates);
+	return out;
+}
+
+}  // namespace codemark::detect

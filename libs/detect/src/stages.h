@@ -1,0 +1,189 @@
+#pragma once
+/** \file stages.h
+ * Internal: one function per stage of the detector (paper-notes "Landmark
+ * recognition"), declared here so that tests can run a single stage on a
+ * crafted input. detect() in detector.cpp calls them in this order.
+ */
+#include <codemark/detect/options.h>
+#include <codemark/landmark/camera.h>
+#include <codemark/landmark/codebook.h>
+#include <codemark/landmark/geometry.h>
+
+#include <opencv2/core.hpp>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace codemark::detect
+{
+// ---------------------------------------------------------------- stage 1+2
+/** Smoothing and colour segmentation: a CV_8UC1 mask (255 = green fill) of
+ * floor(rows / step) x floor(cols / step) cells; cell (i, j) stands for the
+ * step x step block with top-left pixel (j*step, i*step). Empty for an image
+ * smaller than one block. \a bgr must be CV_8UC3. */
+cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p);
+
+/** The segmentation predicate on one (smoothed) colour [0..255 each]. */
+bool isFillColour(double r, double g, double b, const SegmentationParams& p);
+
+// ------------------------------------------------------------------ stage 3
+/** A connected component of the mask that passed the area and shape tests:
+ * one candidate green fill. Coordinates in full-image pixels. */
+struct Candidate
+{
+	int label = 0;  //!< label in the components image
+	cv::Rect bbox;  //!< bounding box of the component's blocks [px]
+	cv::Rect roi;  //!< bbox grown to include the black frame, clipped [px]
+	Eigen::Vector2d centroid = Eigen::Vector2d::Zero();  //!< [px]
+	double area_px = 0;  //!< number of blocks x step^2 [px^2]
+	double compactness = 0;  //!< eta20 + eta02 (Hu's first invariant)
+	double elongation = 0;  //!< ratio of principal standard deviations
+	double fill_g = 0;  //!< mean G of the component's blocks [grey levels]
+};
+
+/** N4-connected components of \a mask (from segmentColour with grid step
+ * \a step), filtered by cardinality and compactness, largest first. The
+ * labels image is returned through \a labels and the number of components
+ * (before filtering) through \a num_components when given. */
+std::vector<Candidate> findCandidates(
+	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
+	cv::Mat* labels = nullptr, int* num_components = nullptr);
+
+// ------------------------------------------------------------------ stage 4
+/** Polarity of an edgel, named after the inner frame edge that has it: the
+ * gradient of G points into the green fill. */
+enum class Polarity : uint8_t
+{
+	None = 0,
+	Top = 1,  //!< G rises downwards (+v): the top inner edge
+	Right = 2,  //!< G falls rightwards (-u): the right inner edge
+	Bottom = 3,  //!< G falls downwards (-v): the bottom inner edge
+	Left = 4  //!< G rises rightwards (+u): the left inner edge
+};
+
+/** An 8-connected set of edgels of one polarity. */
+struct EdgelDomain
+{
+	Polarity polarity = Polarity::None;
+	int count = 0;  //!< number of edgels
+	Eigen::Vector2d mean = Eigen::Vector2d::Zero();  //!< centroid [px]
+	Eigen::Vector2d dir = Eigen::Vector2d::UnitX();  //!< principal direction (unit)
+	double length_px = 0;  //!< extent along dir (max - min projection) [px]
+	double width_px = 0;  //!< sqrt of the smaller eigenvalue (slimness) [px]
+	Eigen::Vector2d end0 = Eigen::Vector2d::Zero(), end1 = Eigen::Vector2d::Zero();  //!< extreme edgels along dir
+};
+
+/** Edgels of one ROI. */
+struct EdgelMap
+{
+	cv::Rect roi;  //!< in full-image pixels
+	cv::Mat polarity;  //!< CV_8UC1 of roi size, Polarity values
+	std::vector<EdgelDomain> domains;  //!< with at least min_edgels edgels
+	double threshold = 0;  //!< gradient threshold used [grey levels / px]
+};
+
+/** Gradient threshold for a candidate whose fill has mean G \a fill_g. */
+double gradientThreshold(double fill_g, const EdgelParams& p);
+
+/** Gradients of G (3x3 Sobel) in \a roi at full resolution, non-maximum
+ * suppressed edgels with polarity, grouped into domains. */
+EdgelMap findEdgels(
+	const cv::Mat& bgr, const cv::Rect& roi, double threshold, const EdgelParams& p);
+
+// ------------------------------------------------------------------ stage 5
+/** The four inner-edge segments in the order top, right, bottom, left. */
+using SideSegments = std::array<EdgelDomain, 4>;
+
+/** Picks, for each side, the domain of that polarity on that side of the
+ * fill's centroid, long and slim enough, nearest the centroid. */
+std::optional<SideSegments> selectSegments(
+	const std::vector<EdgelDomain>& domains, const Candidate& c, const SegmentParams& p);
+
+// ------------------------------------------------------------------ stage 6
+/** Coarse corners TL, TR, BR, BL [raw px]. */
+using Quad = std::array<Eigen::Vector2d, 4>;
+
+/** Intersects neighbouring segments' lines; fails unless every segment end
+ * lies near its corner and the quadrangle is convex, in image order, with
+ * sides of at least min_side_px. */
+std::optional<Quad> linkQuadrangle(const SideSegments& s, const QuadParams& p);
+
+// ------------------------------------------------------------------ stage 7
+/** How locateRisingEdge() places the edge. */
+enum class EdgeMode
+{
+	Centroid,  //!< centroid of the derivative response around its peak
+	IsolatedCentroid,  //!< the same, stopping where the response rises again (a neighbouring edge)
+	Peak  //!< the derivative's peak: a Gaussian through three samples
+};
+
+/** Sub-pixel position of a step edge on a 1D profile, from the derivative
+ * (values[k+1] - values[k-1]) around its largest value within [lo, hi]
+ * (indices), the edge rising in the direction of increasing index. Nullopt
+ * when the peak derivative is below \a min_rise (grey levels per px). */
+std::optional<double> locateRisingEdge(
+	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
+	EdgeMode mode = EdgeMode::Centroid);
+
+/** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
+struct LineFit
+{
+	Eigen::Vector2d normal = Eigen::Vector2d::UnitX();
+	double c = 0;
+	double rms_px = 0;  //!< RMS distance of the kept points [px]
+	int support = 0;  //!< number of kept points
+	std::vector<Eigen::Vector2d> points;  //!< all edge points given (debug)
+};
+
+/** TLS fit with iterative outlier rejection (robust sigma from the median
+ * absolute residual). Nullopt with fewer than min_support points kept. */
+std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> points, const SubpixelParams& p);
+
+/** The refined quadrangle. */
+struct RefinedQuad
+{
+	Quad corners_raw;  //!< TL, TR, BR, BL in raw (distorted) pixels
+	Quad corners_ideal;  //!< the same undistorted
+	std::array<LineFit, 4> sides;  //!< top, right, bottom, left, in undistorted px
+};
+
+/** Edge profiles along each side of \a coarse (one per row or column), the
+ * sub-pixel edge points undistorted, a line per side, corners from
+ * neighbouring intersections distorted back to raw pixels. \a min_rise is
+ * the smallest G slope of an edge [grey levels / px]; \a frame_ratio the
+ * black frame's width over the inner side (0.125 for the spec's landmark). */
+std::optional<RefinedQuad> refineQuadrangle(
+	const cv::Mat& bgr, const Quad& coarse, const CameraModel& camera, double min_rise,
+	double frame_ratio, const SubpixelParams& p);
+
+// ------------------------------------------------------------------ stage 8
+/** The code of one landmark. */
+struct CodeReading
+{
+	int id = -1;
+	CodeCells cells{};  //!< true = black
+	std::array<double, 9> cell_g{};  //!< mean G of each cell, row by row
+	double black_g = 0;  //!< G of the black frame
+	double green_g = 0;  //!< G of the green fill
+	double margin = 0;  //!< smallest |cell - threshold| [grey levels]
+};
+
+/** Homography from normalised face coordinates (s/h right, t/h up; the
+ * reference square is [-1, 1]^2) to ideal pixels, from corners TL, TR, BR,
+ * BL. */
+Eigen::Matrix3d faceToImage(const Quad& corners_ideal);
+
+/** Mean G at a raw pixel position (bilinear); nullopt outside the image. */
+std::optional<double> sampleG(const cv::Mat& bgr, double u, double v);
+
+/** Checks the frame (inside the image, black on every side, green ring) and
+ * reads the 3x3 cells; nullopt when any check fails, the centre cell is
+ * green or a cell is ambiguous. */
+std::optional<CodeReading> readCode(
+	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera,
+	const LandmarkGeometry& g, const CodeParams& p);
+
+}  // namespace codemark::detect

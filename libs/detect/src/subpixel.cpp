@@ -1,0 +1,264 @@
+// Stage 7: sub-pixel edge points, line fits, corners.
+#include "stages.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace codemark::detect
+{
+std::optional<double> locateRisingEdge(
+	const int* v, int n, int lo, int hi, double min_rise, const SubpixelParams& p, EdgeMode mode)
+{
+	lo = std::max(lo, 1);
+	hi = std::min(hi, n - 2);
+	if (lo > hi) return std::nullopt;
+	// Central difference, twice the slope [grey levels / px].
+	auto d = [&](int k) { return v[k + 1] - v[k - 1]; };
+	int peak = lo;
+	for (int k = lo + 1; k <= hi; ++k)
+		if (d(k) > d(peak)) peak = k;
+	const int dp = d(peak);
+	if (dp < 2 * min_rise) return std::nullopt;
+	const bool at_peak = mode == EdgeMode::Peak;
+	const bool monotone = mode == EdgeMode::IsolatedCentroid;
+	if (at_peak)
+	{
+		// The derivative's peak: a Gaussian (log-parabola) through the three
+		// samples around it.
+		const double a = d(peak - 1 >= 1 ? peak - 1 : peak), c = d(peak + 1 <= n - 2 ? peak + 1 : peak);
+		if (a > 0 && c > 0)
+		{
+			const double la = std::log(a), lb = std::log(double(dp)), lc = std::log(c);
+			const double den = la - 2 * lb + lc;
+			if (den < 0) return peak + std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
+		}
+		return peak;
+	}
+	// The response of a blurred step: sum the derivative while it stays
+	// positive and above a fraction of the peak; its centroid is the edge
+	// (exact for any symmetric point-spread function, box or Gaussian).
+	const double floor_v = p.response_floor * dp;
+	double s0 = dp, s1 = double(dp) * peak;
+	for (int k = peak - 1; k >= std::max(1, peak - p.reach_px); --k)
+	{
+		const int dk = d(k);
+		if (dk <= floor_v || (monotone && dk > d(k + 1))) break;
+		s0 += dk;
+		s1 += double(dk) * k;
+	}
+	for (int k = peak + 1; k <= std::min(n - 2, peak + p.reach_px); ++k)
+	{
+		const int dk = d(k);
+		if (dk <= floor_v || (monotone && dk > d(k - 1))) break;
+		s0 += dk;
+		s1 += double(dk) * k;
+	}
+	return s1 / s0;
+}
+
+namespace
+{
+bool fitTls(const std::vector<Eigen::Vector2d>& pts, const std::vector<char>& keep, LineFit& f)
+{
+	Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+	int n = 0;
+	for (size_t i = 0; i < pts.size(); ++i)
+		if (keep[i])
+		{
+			mean += pts[i];
+			++n;
+		}
+	if (n < 2) return false;
+	mean /= n;
+	Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+	for (size_t i = 0; i < pts.size(); ++i)
+		if (keep[i])
+		{
+			const Eigen::Vector2d e = pts[i] - mean;
+			cov += e * e.transpose();
+		}
+	Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+	f.normal = es.eigenvectors().col(0);
+	f.c = -f.normal.dot(mean);
+	f.support = n;
+	return true;
+}
+}  // namespace
+
+std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelParams& p)
+{
+	LineFit f;
+	std::vector<char> keep(pts.size(), 1);
+	if (static_cast<int>(pts.size()) < std::max(2, p.min_support)) return std::nullopt;
+	if (!fitTls(pts, keep, f)) return std::nullopt;
+	std::vector<double> r(pts.size());
+	for (int it = 0; it < 3; ++it)
+	{
+		std::vector<double> absr;
+		absr.reserve(pts.size());
+		for (size_t i = 0; i < pts.size(); ++i)
+		{
+			r[i] = std::abs(f.normal.dot(pts[i]) + f.c);
+			if (keep[i]) absr.push_back(r[i]);
+		}
+		std::nth_element(absr.begin(), absr.begin() + absr.size() / 2, absr.end());
+		const double sigma = 1.4826 * absr[absr.size() / 2];
+		const double limit = std::max(p.outlier_sigmas * sigma, p.min_outlier_px);
+		bool changed = false;
+		for (size_t i = 0; i < pts.size(); ++i)
+		{
+			const char k = r[i] <= limit;
+			changed |= k != keep[i];
+			keep[i] = k;
+		}
+		if (!changed) break;
+		if (!fitTls(pts, keep, f) || f.support < p.min_support) return std::nullopt;
+	}
+	double ss = 0;
+	for (size_t i = 0; i < pts.size(); ++i)
+		if (keep[i])
+		{
+			const double e = f.normal.dot(pts[i]) + f.c;
+			ss += e * e;
+		}
+	f.rms_px = std::sqrt(ss / f.support);
+	if (f.support < p.min_support || f.rms_px > p.max_rms_px) return std::nullopt;
+	f.points = std::move(pts);
+	return f;
+}
+
+std::optional<RefinedQuad> refineQuadrangle(
+	const cv::Mat& bgr, const Quad& coarse, const CameraModel& cam, double min_rise,
+	double frame_ratio, const SubpixelParams& p)
+{
+	RefinedQuad out;
+	const bool distorted = cam.hasDistortion();
+	const Eigen::Vector2d centre = 0.25 * (coarse[0] + coarse[1] + coarse[2] + coarse[3]);
+	const int W = bgr.cols, H = bgr.rows;
+	const int half = p.search_px + p.reach_px + 2;
+	std::vector<int> prof(2 * half + 1), prof_rb(2 * half + 1);
+	for (int side = 0; side < 4; ++side)
+	{
+		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
+		// bottom: BR-BL, left: BL-TL).
+		const Eigen::Vector2d a = coarse[side], b = coarse[(side + 1) % 4];
+		const Eigen::Vector2d ab = b - a;
+		// Scan rows for a mostly vertical side, columns otherwise; the
+		// profile runs across the side along the other axis.
+		const int along = std::abs(ab.y()) >= std::abs(ab.x()) ? 1 : 0;
+		const int across = 1 - along;
+		// Profiles point into the fill, where G rises.
+		const Eigen::Vector2d mid = 0.5 * (a + b);
+		const int inward = centre(across) > mid(across) ? 1 : -1;
+		// Width of the black frame across this side [px], from the extent of
+		// the neighbouring sides: when thin, the frame's outer edge (of
+		// opposite sign) overlaps the response and shifts its centroid
+		// inwards, while the peak barely moves.
+		const Eigen::Vector2d prev_side = coarse[side] - coarse[(side + 3) % 4];
+		const Eigen::Vector2d next_side = coarse[(side + 2) % 4] - coarse[(side + 1) % 4];
+		const double frame_px =
+			frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across)));
+		const EdgeMode mode = frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
+		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
+		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
+		std::vector<Eigen::Vector2d> pts;
+		pts.reserve(static_cast<size_t>(std::max(0.0, s1 - s0)) + 1);
+		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
+		{
+			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
+			const int c0 = static_cast<int>(std::lround(cpred));
+			// Profile index i <-> across coordinate c0 + inward * (i - half).
+			if (along == 1)
+			{
+				if (s < 0 || s >= H) continue;
+				const uint8_t* row = bgr.ptr<uint8_t>(s);
+				bool inside = true;
+				for (int i = 0; i <= 2 * half; ++i)
+				{
+					const int u = c0 + inward * (i - half);
+					if (u < 0 || u >= W) { inside = false; break; }
+					prof[i] = row[3 * u + 1];
+					prof_rb[i] = -(row[3 * u] + row[3 * u + 2]);
+				}
+				if (!inside) continue;
+			}
+			else
+			{
+				if (s < 0 || s >= W) continue;
+				bool inside = true;
+				for (int i = 0; i <= 2 * half; ++i)
+				{
+					const int v = c0 + inward * (i - half);
+					if (v < 0 || v >= H) { inside = false; break; }
+					const uint8_t* px = bgr.ptr<uint8_t>(v) + 3 * s;
+					prof[i] = px[1];
+					prof_rb[i] = -(px[0] + px[2]);
+				}
+				if (!inside) continue;
+			}
+			// G saturates on bright fills (the sensor clips at 255), which
+			// cuts the response on the bright side and pulls its centroid
+			// towards the frame. The edge is then found in R + B, dark in the
+			// green fill and unsaturated in the black frame, or failing that
+			// at the G derivative's peak. Saturated: the fill side of the
+			// profile averages above saturation_level (noise around a fill of
+			// exactly 255 does not count).
+			const int n = static_cast<int>(prof.size());
+			const int lo = half - p.search_px, hi = half + p.search_px;
+			double fill_sum = 0;
+			for (int i = hi + 2; i < n; ++i) fill_sum += prof[i];
+			std::optional<double> e;
+			if (fill_sum < p.saturation_level * (n - hi - 2))
+				e = locateRisingEdge(prof.data(), n, lo, hi, min_rise, p, mode);
+			else
+			{
+				// In R + B the frame's outer edge (white to black) rises too,
+				// a frame width away: search only next to the G peak and stop
+				// the response where it stops falling.
+				const auto g_peak = locateRisingEdge(prof.data(), n, lo, hi, min_rise, p, EdgeMode::Peak);
+				if (g_peak)
+				{
+					const int k = static_cast<int>(std::lround(*g_peak));
+					if (mode == EdgeMode::Centroid)
+						e = locateRisingEdge(
+							prof_rb.data(), n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
+					if (!e) e = g_peak;
+				}
+			}
+			if (!e) continue;
+			const double c = c0 + inward * (*e - half);
+			Eigen::Vector2d pt = along == 1 ? Eigen::Vector2d(c, s) : Eigen::Vector2d(s, c);
+			// Lines are straight only without distortion: fit undistorted.
+			if (distorted) pt = cam.undistortPixel(pt);
+			pts.push_back(pt);
+		}
+		auto f = fitLine(std::move(pts), p);
+		if (!f) return std::nullopt;
+		out.sides[side] = std::move(*f);
+	}
+	// Corner k = side k-1 x side k (TL = left x top, ...).
+	for (int k = 0; k < 4; ++k)
+	{
+		const LineFit& l1 = out.sides[(k + 3) % 4];
+		const LineFit& l2 = out.sides[k];
+		const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
+									  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
+		if (std::abs(h.z()) < 1e-9) return std::nullopt;
+		out.corners_ideal[k] = h.head<2>() / h.z();
+		if (distorted)
+		{
+			const Eigen::Vector2d xn(
+				(out.corners_ideal[k].x() - cam.cx()) / cam.fx(),
+				(out.corners_ideal[k].y() - cam.cy()) / cam.fy());
+			out.corners_raw[k] = cam.distortNormalized(xn);
+		}
+		else
+			out.corners_raw[k] = out.corners_ideal[k];
+		// The refinement must stay near the coarse corner.
+		if ((out.corners_raw[k] - coarse[k]).norm() > 3.0 + p.search_px) return std::nullopt;
+	}
+	return out;
+}
+
+}  // namespace codemark::detect
