@@ -1,0 +1,81 @@
+/** \file main.cpp
+ * codemark-accuracy-map: the paper's Figs. 5-8 on renders (issue 4). Parses
+ * the command line and calls the survey in accuracy_map.h.
+ */
+#include <tclap/CmdLine.h>
+
+#include <exception>
+#include <iostream>
+
+#include "../common/progress.h"
+#include "accuracy_map.h"
+
+int main(int argc, char** argv)
+{
+	namespace ca = codemark::accuracy;
+	try
+	{
+		TCLAP::CmdLine cmd(
+			"Renders the survey grid of the paper's section 4 (one half plane in front of a "
+			"landmark: cells of --cell m, 0.5-5 m, view angles up to 70 deg; a level camera at the "
+			"landmark centre's height looking at it), detects the landmark, measures it with the "
+			"closed form and the general 6-DoF path, and writes heat maps of the mean absolute "
+			"errors of l2, phi2, x and y beside the predicted sigma (heat_*.png), cells.csv and "
+			"summary.txt (the table against the paper's claims) into --out. With AprilTag 3 "
+			"(tag36h11, same corner-square size) at the same poses as a comparison column.",
+			' ', "0.1.0");
+		TCLAP::ValueArg<std::string> out_arg("", "out", "Output folder (created).", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> camera_arg("", "camera",
+			"Camera file (MRPT ini or YAML). Default: the paper's camera. The AprilTag column "
+			"ignores lens distortion.",
+			false, "", "FILE", cmd);
+		TCLAP::ValueArg<int> renders_arg("", "renders", "Noisy renders per cell. Default 5.", false, 5, "N", cmd);
+		TCLAP::ValueArg<double> cell_arg("", "cell", "Grid step [m]. Default 0.5.", false, 0.5, "M", cmd);
+		TCLAP::ValueArg<double> maxd_arg("", "max-distance", "Farthest cell [m]. Default 5.", false, 5.0, "M", cmd);
+		TCLAP::ValueArg<double> noise_arg("", "noise", "Render noise sigma [grey levels]. Default 2.", false, 2.0, "S", cmd);
+		TCLAP::ValueArg<double> blur_arg("", "blur", "Render blur sigma [px]. Default 0.8.", false, 0.8, "PX", cmd);
+		TCLAP::ValueArg<double> sigma_arg("", "sigma-px",
+			"Sigma of each component of P for the predicted covariances [px]. Default: the pose "
+			"library's default.",
+			false, codemark::pose::kDefaultSigmaPx, "PX", cmd);
+		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
+		TCLAP::ValueArg<unsigned long> seed_arg("", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
+		cmd.setExceptionHandling(false);
+		cmd.parse(argc, argv);
+
+		ca::SurveyOptions o;
+		o.renders_per_cell = renders_arg.getValue();
+		o.cell_m = cell_arg.getValue();
+		o.max_distance_m = maxd_arg.getValue();
+		o.noise_sigma = noise_arg.getValue();
+		o.blur_sigma_px = blur_arg.getValue();
+		o.sigma_px = sigma_arg.getValue();
+		o.apriltag = !no_tag_arg.getValue();
+		o.seed = seed_arg.getValue();
+		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) || !(o.sigma_px > 0) ||
+			o.noise_sigma < 0 || o.blur_sigma_px < 0)
+			throw std::invalid_argument("--renders >= 1, --cell, --max-distance, --sigma-px > 0, --noise, --blur >= 0");
+		const codemark::CameraModel camera = camera_arg.getValue().empty()
+			? codemark::CameraModel::paperDefault()
+			: codemark::CameraModel::load(camera_arg.getValue());
+		codemark::app::ProgressBar bar("accuracy-map");
+		const auto cells = ca::runSurvey(camera, o, [&](long d, long t) { bar.update(d, t); });
+		bar.finish();
+		std::cout << ca::writeResults(cells, o, out_arg.getValue());
+		return 0;
+	}
+	catch (const TCLAP::ExitException& e)
+	{
+		return e.getExitStatus();
+	}
+	catch (const TCLAP::ArgException& e)
+	{
+		std::cerr << "codemark-accuracy-map: error: " << e.argId() << ": " << e.error() << " (see --help)\n";
+		return 1;
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "codemark-accuracy-map: error: " << e.what() << "\n";
+		return 1;
+	}
+}
