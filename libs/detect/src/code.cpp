@@ -135,9 +135,9 @@ std::optional<CodeReading> readCode(
 	r.black_g = 0.5 * (sorted[0] + sorted[1]);
 	const double contrast = r.green_g - r.black_g;
 	if (contrast < p.min_contrast) return std::nullopt;
+	if (r.black_g > p.max_black_ratio * r.green_g) return std::nullopt;
 	for (int side = 0; side < 4; ++side)
-		if (black[side] > p.max_black_ratio * green[side] ||
-			green[side] < r.black_g + 0.5 * contrast)
+		if (black[side] > p.max_side_black_ratio * green[side] || green[side] < r.black_g + 0.5 * contrast)
 			return std::nullopt;
 	const double thr = 0.5 * (r.green_g + r.black_g);
 	const double cell = geo.cell_size_m / h;

@@ -131,10 +131,16 @@ std::optional<SideSegments> selectSegments(
 		const Polarity pol = order[k];
 		const bool vertical_side = pol == Polarity::Left || pol == Polarity::Right;
 		const double extent = vertical_side ? c.bbox.height : c.bbox.width;
-		// The side lies on the far side of the centroid along the gradient:
-		// left of it for the left edge, etc.
+		// The side lies beyond the centroid along the gradient (left of it
+		// for the left edge, etc.), and the inner edge bounds the fill: of
+		// the qualifying domains, the one nearest the fill's bounding box
+		// side (code-cell edges lie 35/160 of a side inside it, edges
+		// outside the frame a frame width and more outside it).
 		const int axis = vertical_side ? 0 : 1;
-		const double sign = (pol == Polarity::Left || pol == Polarity::Top) ? -1.0 : 1.0;
+		const bool low_side = pol == Polarity::Left || pol == Polarity::Top;
+		const double bbox_side = low_side
+			? (axis == 0 ? c.bbox.x : c.bbox.y) - 0.5
+			: (axis == 0 ? c.bbox.x + c.bbox.width : c.bbox.y + c.bbox.height) - 0.5;
 		const EdgelDomain* best = nullptr;
 		double best_dist = std::numeric_limits<double>::max();
 		for (const auto& d : domains)
@@ -144,8 +150,8 @@ std::optional<SideSegments> selectSegments(
 			if (d.length_px < p.min_rel_length * extent) continue;
 			// Along the side: a vertical side's direction is mostly vertical.
 			if (std::abs(d.dir(1 - axis)) < std::abs(d.dir(axis))) continue;
-			const double dist = sign * (d.mean(axis) - c.centroid(axis));
-			if (dist <= 0) continue;
+			if (low_side ? d.mean(axis) >= c.centroid(axis) : d.mean(axis) <= c.centroid(axis)) continue;
+			const double dist = std::abs(d.mean(axis) - bbox_side);
 			if (dist < best_dist)
 			{
 				best_dist = dist;

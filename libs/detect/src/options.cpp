@@ -74,6 +74,7 @@ void forEachField(Options& o, F&& f)
 	f("code.patch_fraction", o.code.patch_fraction);
 	f("code.min_contrast", o.code.min_contrast);
 	f("code.max_black_ratio", o.code.max_black_ratio);
+	f("code.max_side_black_ratio", o.code.max_side_black_ratio);
 	f("code.min_margin", o.code.min_margin);
 	f("code.border_px", o.code.border_px);
 }
@@ -114,6 +115,8 @@ void DetectorOptions::validate() const
 	require(code.patch_fraction > 0 && code.patch_fraction <= 1, "code.patch_fraction", "in (0, 1]");
 	require(code.min_contrast >= 0, "code.min_contrast", ">= 0");
 	require(code.max_black_ratio > 0 && code.max_black_ratio < 1, "code.max_black_ratio", "in (0, 1)");
+	require(code.max_side_black_ratio >= code.max_black_ratio && code.max_side_black_ratio < 1,
+		"code.max_side_black_ratio", "in [max_black_ratio, 1)");
 	require(code.min_margin >= 0 && code.min_margin < 0.5, "code.min_margin", "in [0, 0.5)");
 	require(std::isfinite(code.border_px), "code.border_px", "finite");
 }

@@ -98,7 +98,8 @@ EdgelMap findEdgels(
 using SideSegments = std::array<EdgelDomain, 4>;
 
 /** Picks, for each side, the domain of that polarity on that side of the
- * fill's centroid, long and slim enough, nearest the centroid. */
+ * fill's centroid, long and slim enough, nearest the fill's bounding box
+ * side. */
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const SegmentParams& p);
 

@@ -154,9 +154,14 @@ struct CodeParams
 	double patch_fraction = 0.4;
 	/** Smallest contrast G(green) - G(black) [grey levels]. */
 	double min_contrast = 20;
-	/** The frame's mean G on each side must stay below this fraction of the
-	 * fill's (a black frame, not a grey or coloured one). */
-	double max_black_ratio = 0.55;
+	/** The frame's G (mean of its two darkest sides) must stay below this
+	 * fraction of the fill's: a black frame, not a grey or coloured one
+	 * (printed black under the spec's colours: ~0.1). */
+	double max_black_ratio = 0.35;
+	/** Each side of the frame must stay below this fraction of the fill's G
+	 * next to it (looser: at 60 deg and 5 m a side is under 2 px wide and
+	 * blurs towards its neighbours). */
+	double max_side_black_ratio = 0.6;
 	/** Each cell's distance to the threshold must be at least this fraction
 	 * of the contrast (else ambiguous: rejected). */
 	double min_margin = 0.15;

@@ -1,0 +1,443 @@
+// Each stage of the detector on small crafted inputs.
+#include <codemark/detect/detector.h>
+#include <codemark/landmark/codebook.h>
+
+#include "stages.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace codemark;
+using namespace codemark::detect;
+
+namespace
+{
+const cv::Scalar kBlack(25, 25, 25), kGreen(0, 255, 0), kWhite(235, 235, 235);
+
+/** An axis-aligned landmark drawn with whole pixels: outer frame pixels
+ * [o, o + 100), inner [o + 10, o + 90), so the inner corners lie at
+ * o + 9.5 and o + 89.5; cells of 15 px. */
+cv::Mat craftedLandmark(int id, int o = 40, double blur = 0.8, int size = 180)
+{
+	cv::Mat img(size, size, CV_8UC3, kWhite);
+	cv::rectangle(img, cv::Rect(o, o, 100, 100), kBlack, cv::FILLED);
+	cv::rectangle(img, cv::Rect(o + 10, o + 10, 80, 80), kGreen, cv::FILLED);
+	const CodeCells cells = encodeId(id);
+	// Board: 45 px centred in the 80 px fill: cells start at o + 10 + 17.5.
+	for (int r = 0; r < 3; ++r)
+		for (int c = 0; c < 3; ++c)
+			if (cells[r][c]) cv::rectangle(img, cv::Rect(o + 28 + 15 * c, o + 28 + 15 * r, 15, 15), kBlack, cv::FILLED);
+	if (blur > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), blur);
+	return img;
+}
+
+std::array<Eigen::Vector2d, 4> craftedCorners(int o = 40)
+{
+	const double a = o + 9.5, b = o + 89.5;
+	return {Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b), Eigen::Vector2d(a, b)};
+}
+}  // namespace
+
+// ------------------------------------------------------------ segmentation
+
+TEST(Segmentation, PredicateAcceptsGreensAndRejectsOthers)
+{
+	const SegmentationParams p;
+	EXPECT_TRUE(isFillColour(0, 255, 0, p));
+	EXPECT_TRUE(isFillColour(0, 77, 0, p));  // gain 0.3
+	EXPECT_TRUE(isFillColour(20, 200, 40, p));
+	EXPECT_FALSE(isFillColour(128, 128, 128, p));  // grey
+	EXPECT_FALSE(isFillColour(235, 235, 235, p));  // white
+	EXPECT_FALSE(isFillColour(5, 9, 5, p));  // black: too dark
+	EXPECT_FALSE(isFillColour(200, 40, 30, p));  // red
+	EXPECT_FALSE(isFillColour(30, 40, 200, p));  // blue
+	EXPECT_FALSE(isFillColour(0, 220, 230, p));  // yellow-green? no: cyan-ish (B > G)
+	EXPECT_FALSE(isFillColour(230, 240, 0, p));  // yellow: hue ~62 deg
+	EXPECT_FALSE(isFillColour(150, 190, 150, p));  // pale green: low saturation
+}
+
+TEST(Segmentation, MaskHasGridSizeAndMarksTheFill)
+{
+	const cv::Mat img = craftedLandmark(0, 40, 0);
+	SegmentationParams p;
+	const cv::Mat m = segmentColour(img, p);
+	ASSERT_EQ(m.rows, img.rows / 2);
+	ASSERT_EQ(m.cols, img.cols / 2);
+	// Cell (i, j) is pixel (2j, 2i): fill at pixel 55, frame at 45, white at 10.
+	EXPECT_EQ(m.at<uint8_t>(28, 28), 255);
+	EXPECT_EQ(m.at<uint8_t>(22, 22), 0);
+	EXPECT_EQ(m.at<uint8_t>(5, 5), 0);
+	p.step_px = 1;
+	p.box_smoothing = true;
+	EXPECT_EQ(segmentColour(img, p).size(), img.size());
+}
+
+TEST(Segmentation, TinyAndEmptyImagesGiveAnEmptyMask)
+{
+	const SegmentationParams p;
+	EXPECT_TRUE(segmentColour(cv::Mat(0, 0, CV_8UC3), p).empty());
+	EXPECT_TRUE(segmentColour(cv::Mat(1, 1, CV_8UC3, kGreen), p).empty());
+	EXPECT_THROW(segmentColour(cv::Mat(4, 4, CV_8UC1), p), std::invalid_argument);
+}
+
+// -------------------------------------------------------------- components
+
+TEST(Components, HandMadeMask)
+{
+	cv::Mat mask = cv::Mat::zeros(60, 80, CV_8UC1);
+	cv::rectangle(mask, cv::Rect(10, 10, 20, 20), 255, cv::FILLED);  // a square
+	cv::rectangle(mask, cv::Rect(40, 5, 1, 50), 255, cv::FILLED);  // a thin line
+	cv::rectangle(mask, cv::Rect(75, 55, 2, 2), 255, cv::FILLED);  // a speck
+	// Touching diagonally only: a separate component under N4.
+	cv::rectangle(mask, cv::Rect(50, 30, 10, 10), 255, cv::FILLED);
+	cv::rectangle(mask, cv::Rect(60, 40, 10, 10), 255, cv::FILLED);
+	const cv::Mat img(120, 160, CV_8UC3, kGreen);
+	ComponentParams p;
+	cv::Mat labels;
+	int n = 0;
+	const auto c = findCandidates(mask, 2, img, p, &labels, &n);
+	EXPECT_EQ(n, 5);
+	EXPECT_NE(labels.at<int>(39, 59), labels.at<int>(40, 60));
+	// The line is too elongated, the speck too small: the square and the two
+	// small squares remain, largest first.
+	ASSERT_EQ(c.size(), 3u);
+	EXPECT_EQ(c[0].bbox, cv::Rect(20, 20, 40, 40));
+	EXPECT_NEAR(c[0].centroid.x(), 39.5, 1e-9);
+	EXPECT_NEAR(c[0].centroid.y(), 39.5, 1e-9);
+	EXPECT_NEAR(c[0].compactness, 1.0 / 6, 1e-3);
+	EXPECT_NEAR(c[0].elongation, 1.0, 1e-6);
+	EXPECT_NEAR(c[0].area_px, 1600, 1e-9);
+	EXPECT_NEAR(c[0].fill_g, 255, 1e-9);
+	EXPECT_TRUE(c[0].roi.contains(cv::Point(20 - 10, 20 - 10)));
+	EXPECT_TRUE(cv::Rect(0, 0, 160, 120).contains(c[0].roi.br() - cv::Point(1, 1)));
+}
+
+TEST(Components, ARingIsCompactEnoughAndALShapeIsNot)
+{
+	cv::Mat mask = cv::Mat::zeros(100, 100, CV_8UC1);
+	cv::rectangle(mask, cv::Rect(10, 10, 32, 32), 255, cv::FILLED);
+	cv::rectangle(mask, cv::Rect(17, 17, 18, 18), 0, cv::FILLED);  // an all-black board (90/160)
+	cv::rectangle(mask, cv::Rect(50, 50, 45, 3), 255, cv::FILLED);  // a thin L
+	cv::rectangle(mask, cv::Rect(50, 50, 3, 45), 255, cv::FILLED);
+	const cv::Mat img(200, 200, CV_8UC3, kGreen);
+	const auto c = findCandidates(mask, 2, img, ComponentParams());
+	ASSERT_EQ(c.size(), 1u);
+	EXPECT_NEAR(c[0].compactness, 0.32, 0.03);
+}
+
+// ------------------------------------------------------------------ edgels
+
+TEST(Edgels, PolarityOfTheInnerEdges)
+{
+	const cv::Mat img = craftedLandmark(0);
+	const auto m = findEdgels(img, cv::Rect(20, 20, 140, 140), 10, EdgelParams());
+	// Inner left edge between pixels 49 and 50: G rises to the right.
+	EXPECT_EQ(m.polarity.at<uint8_t>(90 - 20, 49 - 20) | m.polarity.at<uint8_t>(90 - 20, 50 - 20),
+		static_cast<uint8_t>(Polarity::Left));
+	EXPECT_EQ(m.polarity.at<uint8_t>(90 - 20, 129 - 20) | m.polarity.at<uint8_t>(90 - 20, 130 - 20),
+		static_cast<uint8_t>(Polarity::Right));
+	EXPECT_EQ(m.polarity.at<uint8_t>(49 - 20, 90 - 20) | m.polarity.at<uint8_t>(50 - 20, 90 - 20),
+		static_cast<uint8_t>(Polarity::Top));
+	EXPECT_EQ(m.polarity.at<uint8_t>(129 - 20, 90 - 20) | m.polarity.at<uint8_t>(130 - 20, 90 - 20),
+		static_cast<uint8_t>(Polarity::Bottom));
+	// Non-maximum suppression: one edgel across the edge.
+	int across = 0;
+	for (int x = 44; x <= 56; ++x) across += m.polarity.at<uint8_t>(70, x - 20) == static_cast<uint8_t>(Polarity::Left);
+	EXPECT_EQ(across, 1);
+	// A long slim domain of each polarity.
+	for (const Polarity pol : {Polarity::Top, Polarity::Right, Polarity::Bottom, Polarity::Left})
+	{
+		double longest = 0;
+		for (const auto& d : m.domains)
+			if (d.polarity == pol && d.width_px < 1) longest = std::max(longest, d.length_px);
+		EXPECT_GT(longest, 60) << static_cast<int>(pol);
+	}
+}
+
+TEST(Edgels, FlatImageHasNone)
+{
+	const cv::Mat img(50, 50, CV_8UC3, kGreen);
+	EXPECT_TRUE(findEdgels(img, cv::Rect(0, 0, 50, 50), 5, EdgelParams()).domains.empty());
+	EXPECT_TRUE(findEdgels(img, cv::Rect(48, 48, 10, 10), 5, EdgelParams()).domains.empty());
+}
+
+// ------------------------------------------------- segments and quadrangle
+
+namespace
+{
+std::optional<Quad> coarseQuad(const cv::Mat& img)
+{
+	const cv::Mat mask = segmentColour(img, SegmentationParams());
+	const auto cands = findCandidates(mask, 2, img, ComponentParams());
+	if (cands.size() != 1) return std::nullopt;
+	const auto m = findEdgels(img, cands[0].roi, gradientThreshold(cands[0].fill_g, EdgelParams()), EdgelParams());
+	const auto s = selectSegments(m.domains, cands[0], SegmentParams());
+	if (!s) return std::nullopt;
+	return linkQuadrangle(*s, QuadParams());
+}
+}  // namespace
+
+TEST(Quadrangle, CoarseCornersOfACraftedLandmark)
+{
+	for (int id : {0, 255, 0x5A})
+	{
+		const auto q = coarseQuad(craftedLandmark(id));
+		ASSERT_TRUE(q) << id;
+		const auto truth = craftedCorners();
+		for (int k = 0; k < 4; ++k) EXPECT_LT(((*q)[k] - truth[k]).norm(), 1.5) << id << " corner " << k;
+	}
+}
+
+TEST(Quadrangle, GreenSquareOnBlackGivesAQuadrangle)
+{
+	// A green square on black: the four edges have the inner polarities, so
+	// a quadrangle is found; the code stage rejects it (its centre is green).
+	cv::Mat img(100, 100, CV_8UC3, kBlack);
+	cv::rectangle(img, cv::Rect(20, 20, 60, 60), kGreen, cv::FILLED);
+	EXPECT_TRUE(coarseQuad(img));
+}
+
+TEST(Quadrangle, RejectsSegmentsFarFromTheirCorners)
+{
+	SideSegments s;
+	const Eigen::Vector2d c[4] = {{10, 10}, {50, 10}, {50, 50}, {10, 50}};
+	for (int k = 0; k < 4; ++k)
+	{
+		s[k].mean = 0.5 * (c[k] + c[(k + 1) % 4]);
+		s[k].dir = (c[(k + 1) % 4] - c[k]).normalized();
+		s[k].end0 = c[k] + 2 * s[k].dir;
+		s[k].end1 = c[(k + 1) % 4] - 2 * s[k].dir;
+	}
+	const auto q = linkQuadrangle(s, QuadParams());
+	ASSERT_TRUE(q);
+	for (int k = 0; k < 4; ++k) EXPECT_LT(((*q)[k] - c[k]).norm(), 1e-9);
+	s[0].end0 = c[0] + 30 * s[0].dir;  // a short top segment far from TL
+	EXPECT_FALSE(linkQuadrangle(s, QuadParams()));
+}
+
+// ---------------------------------------------------------------- sub-pixel
+
+namespace
+{
+/** A step from 30 to 230 at \a x0 sampled at integers, blurred by a
+ * Gaussian of \a sigma (exact, via erf) and integrated over each pixel
+ * (numerically). */
+std::vector<int> stepProfile(double x0, double sigma, int n, double hi = 230)
+{
+	std::vector<int> v(n);
+	for (int i = 0; i < n; ++i)
+	{
+		double s = 0;
+		constexpr int kSub = 64;
+		for (int k = 0; k < kSub; ++k)
+		{
+			const double x = i - 0.5 + (k + 0.5) / kSub;
+			s += sigma > 0 ? 0.5 * (1 + std::erf((x - x0) / (std::sqrt(2.0) * sigma))) : (x > x0 ? 1.0 : 0.0);
+		}
+		v[i] = static_cast<int>(std::lround(std::min(255.0, 30 + (hi - 30) * s / kSub)));
+	}
+	return v;
+}
+}  // namespace
+
+TEST(Subpixel, CentroidLocatesABlurredStep)
+{
+	const SubpixelParams p;
+	for (double sigma : {0.0, 0.5, 0.8, 1.5})
+		for (double x0 = 9.0; x0 < 10.0; x0 += 0.1)
+		{
+			const auto v = stepProfile(x0, sigma, 21);
+			const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, p);
+			ASSERT_TRUE(e);
+			EXPECT_NEAR(*e, x0, 0.03) << "sigma " << sigma;
+		}
+}
+
+TEST(Subpixel, PeakModeLocatesAGaussianBlurredStep)
+{
+	const SubpixelParams p;
+	for (double x0 = 9.0; x0 < 10.0; x0 += 0.1)
+	{
+		const auto v = stepProfile(x0, 1.0, 21);
+		const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::Peak);
+		ASSERT_TRUE(e);
+		EXPECT_NEAR(*e, x0, 0.05);
+	}
+}
+
+TEST(Subpixel, NoEdgeOrFallingEdgeGivesNothing)
+{
+	const SubpixelParams p;
+	std::vector<int> flat(21, 100);
+	EXPECT_FALSE(locateRisingEdge(flat.data(), 21, 7, 13, 5, p));
+	auto v = stepProfile(10, 0.8, 21);
+	std::reverse(v.begin(), v.end());
+	EXPECT_FALSE(locateRisingEdge(v.data(), 21, 7, 13, 5, p));
+	// Too weak a step.
+	const auto w = stepProfile(10, 0.8, 21, 36);
+	EXPECT_FALSE(locateRisingEdge(w.data(), 21, 7, 13, 5, p));
+}
+
+TEST(Subpixel, LineFitRejectsOutliers)
+{
+	std::mt19937 rng(3);
+	std::normal_distribution<double> noise(0, 0.05);
+	std::vector<Eigen::Vector2d> pts;
+	// v = 0.1 u + 20
+	for (int u = 0; u < 60; ++u) pts.emplace_back(u, 0.1 * u + 20 + noise(rng));
+	pts[10].y() += 3;
+	pts[40].y() -= 2;
+	const auto f = fitLine(pts, SubpixelParams());
+	ASSERT_TRUE(f);
+	EXPECT_EQ(f->support, 58);
+	EXPECT_LT(f->rms_px, 0.08);
+	// Distance of a point of the true line to the fit.
+	for (double u : {0.0, 59.0}) EXPECT_LT(std::abs(f->normal.dot(Eigen::Vector2d(u, 0.1 * u + 20)) + f->c), 0.05);
+	EXPECT_FALSE(fitLine({pts.begin(), pts.begin() + 3}, SubpixelParams()));
+}
+
+TEST(Subpixel, RefinedCornersOfACraftedLandmark)
+{
+	for (double blur : {0.0, 0.8, 1.5})
+	{
+		const cv::Mat img = craftedLandmark(0x5A, 40, blur);
+		const auto q = coarseQuad(img);
+		ASSERT_TRUE(q);
+		const auto r = refineQuadrangle(img, *q, CameraModel(), 10, 0.125, SubpixelParams());
+		ASSERT_TRUE(r);
+		const auto truth = craftedCorners();
+		for (int k = 0; k < 4; ++k)
+		{
+			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.02) << "blur " << blur << " corner " << k;
+			EXPECT_LT(r->sides[k].rms_px, 0.05);
+			EXPECT_GT(r->sides[k].support, 60);
+		}
+	}
+}
+
+// -------------------------------------------------------------------- code
+
+TEST(Code, HomographyMapsTheUnitSquareToTheCorners)
+{
+	const Quad c = {Eigen::Vector2d(10, 12), Eigen::Vector2d(50, 8), Eigen::Vector2d(55, 60), Eigen::Vector2d(8, 50)};
+	const Eigen::Matrix3d H = faceToImage(c);
+	const double src[4][2] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
+	for (int k = 0; k < 4; ++k)
+	{
+		const Eigen::Vector3d q = H * Eigen::Vector3d(src[k][0], src[k][1], 1);
+		EXPECT_LT((q.head<2>() / q.z() - c[k]).norm(), 1e-9);
+	}
+}
+
+TEST(Code, SampleGIsBilinearAndBounded)
+{
+	cv::Mat img(2, 2, CV_8UC3, cv::Scalar(0, 0, 0));
+	img.at<cv::Vec3b>(0, 1)[1] = 100;
+	EXPECT_NEAR(*sampleG(img, 0.5, 0), 50, 1e-9);
+	EXPECT_NEAR(*sampleG(img, 0.5, 0.5), 25, 1e-9);
+	EXPECT_FALSE(sampleG(img, -0.1, 0));
+	EXPECT_FALSE(sampleG(img, 0, 1.01));
+}
+
+TEST(Code, ReadsEveryIdOfCraftedLandmarks)
+{
+	const LandmarkGeometry g;
+	for (int id = 0; id < 256; id += 17)
+	{
+		const cv::Mat img = craftedLandmark(id);
+		RefinedQuad q;
+		q.corners_raw = q.corners_ideal = craftedCorners();
+		const auto r = readCode(img, q, CameraModel(), g, CodeParams());
+		ASSERT_TRUE(r) << id;
+		EXPECT_EQ(r->id, id);
+		EXPECT_GT(r->margin, 50);
+		EXPECT_LT(r->black_g, 60);
+		EXPECT_GT(r->green_g, 200);
+	}
+}
+
+TEST(Code, RejectsGreenCentreOtherFillAndMissingFrame)
+{
+	const LandmarkGeometry g;
+	RefinedQuad q;
+	q.corners_raw = q.corners_ideal = craftedCorners();
+	cv::Mat img = craftedLandmark(0);
+	cv::rectangle(img, cv::Rect(40 + 43, 40 + 43, 15, 15), kGreen, cv::FILLED);  // centre cell green
+	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
+	// No frame: the frame painted white.
+	img = craftedLandmark(0, 40, 0);
+	cv::rectangle(img, cv::Rect(40, 40, 100, 10), kWhite, cv::FILLED);
+	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
+	// A cut landmark: the outer frame outside the image.
+	img = craftedLandmark(0, 40, 0);
+	const cv::Mat cut = img(cv::Rect(45, 0, 135, 180)).clone();
+	RefinedQuad qc = q;
+	for (auto& c : qc.corners_raw) c.x() -= 45;
+	qc.corners_ideal = qc.corners_raw;
+	EXPECT_FALSE(readCode(cut, qc, CameraModel(), g, CodeParams()));
+}
+
+TEST(Code, AmbiguousCellIsRejected)
+{
+	const LandmarkGeometry g;
+	RefinedQuad q;
+	q.corners_raw = q.corners_ideal = craftedCorners();
+	cv::Mat img = craftedLandmark(0);
+	// Cell (0, 0) halfway between black and green.
+	cv::rectangle(img, cv::Rect(40 + 28, 40 + 28, 15, 15), cv::Scalar(0, 140, 0), cv::FILLED);
+	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
+}
+
+// --------------------------------------------------------------- detect()
+
+TEST(Detect, CraftedLandmarkEndToEnd)
+{
+	const cv::Mat img = craftedLandmark(201);
+	const auto r = detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions());
+	ASSERT_EQ(r.landmarks.size(), 1u);
+	const auto& d = r.landmarks[0].detection;
+	EXPECT_EQ(d.id, 201);
+	const auto truth = craftedCorners();
+	for (int k = 0; k < 4; ++k) EXPECT_LT((d.corners[k] - truth[k]).norm(), 0.02);
+	EXPECT_NEAR(d.quality.area_px, 80.0 * 80.0, 5);
+	EXPECT_GT(d.quality.code_margin, 50);
+	EXPECT_LT(d.quality.corner_sigma_px, 0.05);
+	// P from the corners (lambda = 800, principal point 319.5, 239.5).
+	EXPECT_NEAR(r.landmarks[0].P(0), 49.5 - 319.5, 0.02);
+	EXPECT_NEAR(r.landmarks[0].P(1), 40, 0.02);
+	EXPECT_EQ(r.counts.decoded, 1);
+	EXPECT_GE(r.timings.total_us, r.timings.segmentation_us);
+}
+
+TEST(Detect, DegenerateInputsGiveNothing)
+{
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const DetectorOptions o;
+	EXPECT_TRUE(detect::detect(cv::Mat(), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(0, 0, CV_8UC3), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(1, 1, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(3, 2, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(128, 128, 128)), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(480, 640, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
+	EXPECT_THROW(detect::detect(cv::Mat(10, 10, CV_8UC1), cam, g, o), std::invalid_argument);
+}
+
+TEST(Detect, GreenPostersWithoutAFrameAreNotLandmarks)
+{
+	for (const cv::Scalar& bg : {cv::Scalar(128, 128, 128), kWhite, cv::Scalar(60, 140, 160)})
+	{
+		cv::Mat img(200, 200, CV_8UC3, bg);
+		cv::rectangle(img, cv::Rect(50, 50, 100, 100), kGreen, cv::FILLED);
+		cv::rectangle(img, cv::Rect(90, 90, 20, 20), kBlack, cv::FILLED);  // even with a black centre
+		cv::GaussianBlur(img, img, cv::Size(0, 0), 0.8);
+		EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions()).landmarks.empty());
+	}
+	// A green square on black: a frame, but the centre cell is green.
+	cv::Mat img(200, 200, CV_8UC3, kBlack);
+	cv::rectangle(img, cv::Rect(50, 50, 100, 100), kGreen, cv::FILLED);
+	EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions()).landmarks.empty());
+}
