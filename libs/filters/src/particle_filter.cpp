@@ -1,13 +1,352 @@
-// Particle filter localizer (work in progress: first a linkable factory).
-#include "factories.h"
+// The particle filter localizer: MRPT's CMonteCarloLocalization2D and
+// CParticleFilter over the coded-landmark map (particle_filter.h).
+#include <codemark/filters/particle_filter.h>
+#include <codemark/mrpt/CObservationCodedLandmarks.h>
+#include <codemark/pose/closed_form.h>
+#include <mrpt/math/wrap2pi.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CObservationBearingRange.h>
+#include <mrpt/random/RandomGenerators.h>
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <stdexcept>
 
-namespace codemark::filters::detail
+#include "factories.h"
+
+namespace codemark::filters
+{
+namespace
+{
+constexpr double kDeg = M_PI / 180.0;
+const char* const kSection = "ParticleFilter";
+const char* const kLikelihoodSection = "MetricMap_codedLandmarksMap_00_likelihoodOpts";
+
+/** One draw of N(mean, C) with MRPT's generator (reproducible with
+ * random_seed); C must be positive semi-definite. */
+Eigen::Vector3d drawGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& C)
+{
+	Eigen::LLT<Eigen::Matrix3d> llt(C);
+	auto& rng = mrpt::random::getRandomGenerator();
+	const Eigen::Vector3d z(
+		rng.drawGaussian1D_normalized(), rng.drawGaussian1D_normalized(),
+		rng.drawGaussian1D_normalized());
+	return mean + llt.matrixL() * z;
+}
+
+/** A robot pose hypothesis from one sighting. */
+struct Fix
+{
+	Eigen::Vector3d mean;  //!< x, y [m], yaw [rad]
+	Eigen::Matrix3d cov;
+};
+}  // namespace
+
+// ------------------------------------------------------------------ options
+void ParticleFilterOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	MRPT_LOAD_CONFIG_VAR(particles_count, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(init_margin_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(initial_std_xy_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(initial_std_yaw_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(inject_fraction, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(inject_ess_threshold, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(gate_chi2, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(inject_after_unexplained, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(inject_min_std_xy_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(inject_min_std_yaw_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(converged_std_xy_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(converged_std_yaw_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(random_seed, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(no_odometry_std_xy_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(no_odometry_std_yaw_deg, double, c, s);
+	auto require = [&](bool ok, const char* key, const char* what) {
+		if (!ok)
+			throw std::invalid_argument(
+				std::string("method 'pf': [") + s + "] " + key + " " + what);
+	};
+	require(particles_count > 0, "particles_count", "must be > 0");
+	require(init_margin_m >= 0, "init_margin_m", "must be >= 0");
+	require(initial_std_xy_m >= 0 && initial_std_yaw_deg >= 0, "initial_std_*", "must be >= 0");
+	require(inject_fraction > 0 && inject_fraction <= 1, "inject_fraction", "must be in (0, 1]");
+	require(
+		inject_ess_threshold >= 0 && inject_ess_threshold < 1, "inject_ess_threshold",
+		"must be in [0, 1)");
+	require(gate_chi2 > 0, "gate_chi2", "must be > 0");
+	require(inject_after_unexplained >= 0, "inject_after_unexplained", "must be >= 0");
+	require(
+		inject_min_std_xy_m >= 0 && inject_min_std_yaw_deg >= 0, "inject_min_std_*",
+		"must be >= 0");
+	require(
+		converged_std_xy_m > 0 && converged_std_yaw_deg > 0, "converged_std_*", "must be > 0");
+	require(
+		no_odometry_std_xy_m > 0 && no_odometry_std_yaw_deg > 0, "no_odometry_std_*",
+		"must be > 0");
+}
+
+void ParticleFilterOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "particles_count", particles_count, -1, -1);
+	c.write(s, "init_margin_m", init_margin_m, -1, -1);
+	c.write(s, "initial_std_xy_m", initial_std_xy_m, -1, -1);
+	c.write(s, "initial_std_yaw_deg", initial_std_yaw_deg, -1, -1);
+	c.write(s, "inject_fraction", inject_fraction, -1, -1);
+	c.write(s, "inject_ess_threshold", inject_ess_threshold, -1, -1);
+	c.write(s, "gate_chi2", gate_chi2, -1, -1);
+	c.write(s, "inject_after_unexplained", inject_after_unexplained, -1, -1);
+	c.write(s, "inject_min_std_xy_m", inject_min_std_xy_m, -1, -1);
+	c.write(s, "inject_min_std_yaw_deg", inject_min_std_yaw_deg, -1, -1);
+	c.write(s, "converged_std_xy_m", converged_std_xy_m, -1, -1);
+	c.write(s, "converged_std_yaw_deg", converged_std_yaw_deg, -1, -1);
+	c.write(s, "random_seed", random_seed, -1, -1);
+	c.write(s, "no_odometry_std_xy_m", no_odometry_std_xy_m, -1, -1);
+	c.write(s, "no_odometry_std_yaw_deg", no_odometry_std_yaw_deg, -1, -1);
+}
+
+// ---------------------------------------------------------------- localizer
+ParticleFilterLocalizer::ParticleFilterLocalizer(
+	const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
+	const std::optional<PoseEstimate>& initial)
+{
+	if (map.landmarks.empty())
+		throw std::invalid_argument("method 'pf': the landmark map is empty");
+	try
+	{
+		m_opts.loadFromConfigFile(cfg, kSection);
+		m_pf.m_options.loadFromConfigFile(cfg, "PF_options");
+		m_pdf.options.KLD_params.loadFromConfigFile(cfg, "KLD_options");
+		m_map = std::make_shared<CCodedLandmarksMap>(map);
+		m_map->likelihoodOptions.loadFromConfigFile(cfg, kLikelihoodSection);
+	}
+	catch (const std::invalid_argument&)
+	{
+		throw;
+	}
+	catch (const std::exception& e)
+	{
+		throw std::invalid_argument(std::string("method 'pf': bad configuration: ") + e.what());
+	}
+	if (m_pf.m_options.adaptiveSampleSize &&
+		m_pf.m_options.resamplingMethod != mrpt::bayes::CParticleFilter::prMultinomial)
+		throw std::invalid_argument(
+			"method 'pf': [PF_options] adaptiveSampleSize=1 (KLD) needs resamplingMethod=0 "
+			"(prMultinomial)");
+	if (m_pf.m_options.PF_algorithm == mrpt::bayes::CParticleFilter::pfOptimalProposal)
+		throw std::invalid_argument(
+			"method 'pf': [PF_options] PF_algorithm=2 (pfOptimalProposal) is not offered by "
+			"CMonteCarloLocalization2D; use 0, 1 or 3");
+	if (m_opts.random_seed >= 0)
+		mrpt::random::getRandomGenerator().randomize(static_cast<uint32_t>(m_opts.random_seed));
+	m_pdf.options.metricMap = m_map;
+
+	const auto N = static_cast<size_t>(m_opts.particles_count);
+	if (initial)
+	{
+		// Gaussian around the given pose: its covariance when it has one,
+		// else the configured spread.
+		Eigen::Matrix3d C = initial->cov;
+		if (!(C.determinant() > 0))
+			C = Eigen::Vector3d(
+					m_opts.initial_std_xy_m * m_opts.initial_std_xy_m,
+					m_opts.initial_std_xy_m * m_opts.initial_std_xy_m,
+					std::pow(m_opts.initial_std_yaw_deg * kDeg, 2))
+					.asDiagonal();
+		C += Eigen::Matrix3d::Identity() * 1e-12;
+		const Eigen::Vector3d mean(initial->mean.x(), initial->mean.y(), initial->mean.phi());
+		m_pdf.resetDeterministic(mrpt::math::TPose2D(mean[0], mean[1], mean[2]), N);
+		for (auto& p : m_pdf.m_particles)
+		{
+			const Eigen::Vector3d v = drawGaussian(mean, C);
+			p.d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
+			p.log_w = 0;
+		}
+		m_converged = initial->initialized;
+	}
+	else
+	{
+		mrpt::math::TPoint3D lo, hi;
+		m_map->boundingBox(lo, hi);
+		const double m = m_opts.init_margin_m;
+		m_pdf.resetUniform(lo.x - m, hi.x + m, lo.y - m, hi.y + m, -M_PI, M_PI, static_cast<int>(N));
+	}
+}
+
+StepStats ParticleFilterLocalizer::step(
+	const mrpt::obs::CActionRobotMovement2D* odometry,
+	const mrpt::obs::CSensoryFrame& observations)
+{
+	StepStats stats;
+
+	// The action: the step's odometry, or a still robot with a little noise.
+	mrpt::obs::CActionCollection actions;
+	if (odometry)
+		actions.insert(*odometry);
+	else
+	{
+		mrpt::obs::CActionRobotMovement2D still;
+		mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
+		mm.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
+		mm.gaussianModel.a1 = mm.gaussianModel.a2 = mm.gaussianModel.a3 = mm.gaussianModel.a4 = 0;
+		mm.gaussianModel.minStdXY = m_opts.no_odometry_std_xy_m;
+		mm.gaussianModel.minStdPHI = m_opts.no_odometry_std_yaw_deg * kDeg;
+		still.computeFromOdometry(mrpt::poses::CPose2D(), mm);
+		actions.insert(still);
+	}
+
+	// Only the observations the map scores (the images stay out of the loop).
+	mrpt::obs::CSensoryFrame sf;
+	std::vector<const CObservationCodedLandmarks*> coded;
+	for (const auto& o : observations)
+	{
+		if (!o) continue;
+		if (auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
+		{
+			coded.push_back(c.get());
+			for (const auto& s : c->sightings) (m_map->find(s.id) ? stats.used : stats.unknown_id)++;
+			sf.insert(o);
+		}
+		else if (auto b = std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(o))
+		{
+			for (const auto& m : b->sensedData)
+				(m_map->find(m.landmarkID) ? stats.used : stats.unknown_id)++;
+			sf.insert(o);
+		}
+	}
+
+	m_pf.executeOn(m_pdf, &actions, sf.size() ? &sf : nullptr, &m_stats);
+
+	// Does the best particle explain the frame's coded sightings?
+	auto gatedOut = [&](const mrpt::math::TPose2D& pose) {
+		int known = 0, out = 0;
+		const double c = std::cos(pose.phi), s = std::sin(pose.phi);
+		for (const auto* o : coded)
+		{
+			double cx = 0, cy = 0, cc = 1, cs = 0;
+			if (!CCodedLandmarksMap::cameraInWorld(pose.x, pose.y, c, s, o->cameraPose, cx, cy, cc, cs))
+				continue;
+			for (const auto& sg : o->sightings)
+			{
+				const MapLandmark* lm = m_map->find(sg.id);
+				if (!lm) continue;
+				++known;
+				const Eigen::Vector3d Lp = CCodedLandmarksMap::predictL(
+					cx, cy, cc, cs, lm->x_m, lm->y_m, std::cos(lm->yaw_rad), std::sin(lm->yaw_rad));
+				if (m_map->sightingMahalanobis2(sg.L, sg.C_L, Lp) > m_opts.gate_chi2) ++out;
+			}
+		}
+		return std::make_pair(known, out);
+	};
+	if (!coded.empty() && !m_pdf.m_particles.empty())
+	{
+		const auto best = std::max_element(
+			m_pdf.m_particles.begin(), m_pdf.m_particles.end(),
+			[](const auto& a, const auto& b) { return a.log_w < b.log_w; });
+		const auto [known, out] = gatedOut(best->d);
+		if (known > 0) m_unexplained = (out == known) ? m_unexplained + 1 : 0;
+
+		const bool collapsed = m_opts.inject_ess_threshold > 0 &&
+			m_stats.ESS_beforeResample < m_opts.inject_ess_threshold;
+		const bool lost = m_opts.inject_after_unexplained > 0 &&
+			m_unexplained >= m_opts.inject_after_unexplained;
+		if ((collapsed || lost) && injectAroundFixes(sf))
+		{
+			stats.reinitialized = true;
+			m_unexplained = 0;
+		}
+	}
+
+	// Convergence (sticky) and the sightings the estimate rejects.
+	const PoseEstimate e = estimate();
+	if (!m_converged)
+	{
+		const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(e.cov.topLeftCorner<2, 2>());
+		const double std_xy = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+		const double std_yaw = std::sqrt(std::max(0.0, e.cov(2, 2)));
+		m_converged = std_xy < m_opts.converged_std_xy_m && std_yaw < m_opts.converged_std_yaw_deg * kDeg;
+	}
+	if (m_converged && !coded.empty())
+	{
+		const auto [known, out] = gatedOut(e.mean.asTPose());
+		(void)known;
+		stats.rejected = out;
+		stats.used -= out;
+	}
+	return stats;
+}
+
+bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& observations)
+{
+	std::vector<Fix> fixes;
+	const Eigen::Matrix3d floor = Eigen::Vector3d(
+									  std::pow(m_opts.inject_min_std_xy_m, 2),
+									  std::pow(m_opts.inject_min_std_xy_m, 2),
+									  std::pow(m_opts.inject_min_std_yaw_deg * kDeg, 2))
+									  .asDiagonal();
+	for (const auto& o : observations)
+	{
+		const auto* c = dynamic_cast<const CObservationCodedLandmarks*>(o.get());
+		if (!c) continue;
+		const mrpt::poses::CPose2D robot_T_camera = pose::cameraPlanarPose(c->cameraPose);
+		for (const auto& sg : c->sightings)
+		{
+			const MapLandmark* lm = m_map->find(sg.id);
+			if (!lm) continue;
+			Eigen::Matrix3d C;
+			const mrpt::poses::CPose2D world_T_robot = pose::robotPoseInWorld(
+				sg.pose_in_landmark, sg.C_R, pose::landmarkPlanarPose(lm->world_T_landmark()),
+				robot_T_camera, &C);
+			C = 0.5 * (C + C.transpose()) + floor;
+			if (!C.allFinite() || !(C.determinant() > 0)) continue;
+			fixes.push_back({Eigen::Vector3d(world_T_robot.x(), world_T_robot.y(), world_T_robot.phi()), C});
+		}
+	}
+	auto& parts = m_pdf.m_particles;
+	if (fixes.empty() || parts.empty()) return false;
+
+	// Replace the lowest-weight particles, cycling over the fixes; then
+	// equal weights: the frame's information is in where the samples are.
+	const size_t n = std::max<size_t>(
+		1, static_cast<size_t>(std::lround(m_opts.inject_fraction * double(parts.size()))));
+	std::vector<size_t> order(parts.size());
+	std::iota(order.begin(), order.end(), size_t(0));
+	std::nth_element(
+		order.begin(), order.begin() + static_cast<std::ptrdiff_t>(std::min(n, order.size()) - 1),
+		order.end(), [&](size_t a, size_t b) { return parts[a].log_w < parts[b].log_w; });
+	for (size_t k = 0; k < std::min(n, parts.size()); ++k)
+	{
+		const Fix& f = fixes[k % fixes.size()];
+		const Eigen::Vector3d v = drawGaussian(f.mean, f.cov);
+		parts[order[k]].d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
+	}
+	for (auto& p : parts) p.log_w = 0;
+	++m_injections;
+	return true;
+}
+
+PoseEstimate ParticleFilterLocalizer::estimate() const
+{
+	PoseEstimate e;
+	const auto [cov, mean] = m_pdf.getCovarianceAndMean();
+	e.mean = mean;
+	e.cov = cov.asEigen();
+	e.cov = 0.5 * (e.cov + e.cov.transpose()).eval();
+	e.initialized = m_converged;
+	return e;
+}
+
+// ------------------------------------------------------------------ factory
+namespace detail
 {
 std::unique_ptr<Localizer> makeParticleFilter(
-	const mrpt::config::CConfigFileBase&, const LandmarkMap&, const std::optional<PoseEstimate>&)
+	const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
+	const std::optional<PoseEstimate>& initial)
 {
-	throw std::invalid_argument("method 'pf': the particle filter is not built yet");
+	return std::make_unique<ParticleFilterLocalizer>(cfg, map, initial);
 }
-}  // namespace codemark::filters::detail
+}  // namespace detail
+
+}  // namespace codemark::filters

@@ -1,5 +1,6 @@
 // Registers every serializable class of the plugin once, when the library is
 // loaded (IMPLEMENTS_SERIALIZABLE does not register; mrpt-notes.md).
+#include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/core/initializer.h>
 #include <mrpt/rtti/CObject.h>
@@ -7,4 +8,5 @@
 MRPT_INITIALIZER(codemark_mrpt_register_classes)
 {
 	mrpt::rtti::registerClass(CLASS_ID(codemark::CObservationCodedLandmarks));
+	mrpt::rtti::registerClass(CLASS_ID(codemark::CCodedLandmarksMap));
 }
