@@ -232,6 +232,7 @@ std::vector<CellResult> runSurvey(
 	const detect::DetectorOptions dopt;
 	pose::PoseOptions cf, gen;
 	cf.sigma_px = gen.sigma_px = o.sigma_px;
+	cf.sigma_source = gen.sigma_source = o.sigma_source;
 	gen.method = pose::PoseMethod::General6Dof;
 	const TagRenderer tag(g.inner_size_m);
 	const TagDetector tagdet;
@@ -284,8 +285,8 @@ std::vector<CellResult> runSurvey(
 				}
 				try
 				{
-					accumulate(c.closed_form, pose::measure(dl.detection.corners, camera, g, cf), truth);
-					accumulate(c.general, pose::measure(dl.detection.corners, camera, g, gen), truth);
+					accumulate(c.closed_form, pose::measure(dl.detection, camera, g, cf), truth);
+					accumulate(c.general, pose::measure(dl.detection, camera, g, gen), truth);
 				}
 				catch (const std::exception&)
 				{
@@ -460,9 +461,10 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
 	  << o.renders_per_cell << " renders each, noise " << fmt(o.noise_sigma, 1) << ", blur "
-	  << fmt(o.blur_sigma_px, 2) << " px, sigma_px " << fmt(o.sigma_px, 3) << "\n";
+	  << fmt(o.blur_sigma_px, 2) << " px, sigma_px " << fmt(o.sigma_px, 3) << ", sigma source "
+	  << pose::toString(o.sigma_source) << "\n";
 	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general 6-DoF,"
-		 " tag = AprilTag 3 tag36h11 (same corner square) + general path\n";
+		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's sigma)\n";
 	for (const Region& r : regions)
 	{
 		s << "\n## " << r.name << "\n";

@@ -30,6 +30,8 @@ struct SurveyOptions
 	double noise_sigma = 2.0;  //!< renderer pixel noise [grey levels]
 	double blur_sigma_px = 0.8;  //!< renderer blur [px]
 	double sigma_px = pose::kDefaultSigmaPx;  //!< sigma of each component of P for C_L, C_R [px]
+	/** Fixed: sigma_px; Detector: the detector's per-detection corner sigma. */
+	pose::SigmaSource sigma_source = pose::SigmaSource::Fixed;
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path
 	uint64_t seed = 1;  //!< first render seed
 };

@@ -38,6 +38,9 @@ int main(int argc, char** argv)
 			"Sigma of each component of P for the predicted covariances [px]. Default: the pose "
 			"library's default.",
 			false, codemark::pose::kDefaultSigmaPx, "PX", cmd);
+		TCLAP::ValueArg<std::string> sigma_source_arg("", "sigma-source",
+			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default Fixed.",
+			false, "Fixed", "NAME", cmd);
 		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
 		TCLAP::ValueArg<unsigned long> seed_arg("", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
 		cmd.setExceptionHandling(false);
@@ -51,6 +54,7 @@ int main(int argc, char** argv)
 		o.blur_sigma_px = blur_arg.getValue();
 		o.sigma_px = sigma_arg.getValue();
 		o.apriltag = !no_tag_arg.getValue();
+		o.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		o.seed = seed_arg.getValue();
 		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) || !(o.sigma_px > 0) ||
 			o.noise_sigma < 0 || o.blur_sigma_px < 0)

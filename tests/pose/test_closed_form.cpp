@@ -258,4 +258,29 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
 	cfg.write("POSE", "sigma_px", -1.0);
 	EXPECT_THROW(r.loadFromConfigFile(cfg, "POSE"), std::invalid_argument);
+	EXPECT_EQ(sigmaSourceFromString("detector"), SigmaSource::Detector);
+	EXPECT_THROW(sigmaSourceFromString("auto"), std::invalid_argument);
+}
+
+TEST(Options, SigmaFromTheDetector)
+{
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	Detection d;
+	d.id = 3;
+	d.corners = projectCorners(cameraAt(2.0, 0.3), cam, g);
+	d.quality.corner_sigma_px = 0.2;
+	PoseOptions o;
+	o.sigma_px = 0.05;
+	const Measurement fixed = measure(d, cam, g, o);
+	o.sigma_source = SigmaSource::Detector;
+	const Measurement det = measure(d, cam, g, o);
+	// Covariances scale with sigma^2: (0.2 / sqrt 2 / 0.05)^2 = 8.
+	EXPECT_NEAR(det.C_R(2, 2) / fixed.C_R(2, 2), 8.0, 1e-9);
+	EXPECT_NEAR(det.C_P(0, 0), 0.02, 1e-15);
+	// The floor, and the fallback when the detector gives no estimate.
+	d.quality.corner_sigma_px = 1e-4;
+	EXPECT_NEAR(measure(d, cam, g, o).C_P(1, 1), o.min_sigma_px * o.min_sigma_px, 1e-18);
+	d.quality.corner_sigma_px = 0;
+	EXPECT_NEAR(measure(d, cam, g, o).C_P(1, 1), 0.05 * 0.05, 1e-18);
 }

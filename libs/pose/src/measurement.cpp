@@ -27,6 +27,16 @@ std::string toString(PoseMethod m)
 	return m == PoseMethod::ClosedForm ? "ClosedForm" : "General6Dof";
 }
 
+std::string toString(SigmaSource s) { return s == SigmaSource::Fixed ? "Fixed" : "Detector"; }
+
+SigmaSource sigmaSourceFromString(const std::string& name)
+{
+	const std::string n = lower(name);
+	if (n == "fixed") return SigmaSource::Fixed;
+	if (n == "detector") return SigmaSource::Detector;
+	throw std::invalid_argument("unknown sigma source '" + name + "' (expected Fixed or Detector)");
+}
+
 PoseMethod poseMethodFromString(const std::string& name)
 {
 	const std::string n = lower(name);
@@ -44,6 +54,8 @@ void PoseOptions::validate() const
 		s << "pose options: sigma_px must be finite and > 0, got " << sigma_px;
 		throw std::invalid_argument(s.str());
 	}
+	if (!(min_sigma_px > 0) || !std::isfinite(min_sigma_px))
+		throw std::invalid_argument("pose options: min_sigma_px must be finite and > 0");
 	if (lm_max_iterations < 1)
 		throw std::invalid_argument("pose options: lm_max_iterations must be >= 1");
 }
@@ -52,6 +64,8 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 {
 	method = poseMethodFromString(c.read_string(s, "method", toString(method)));
 	MRPT_LOAD_CONFIG_VAR(sigma_px, double, c, s);
+	sigma_source = sigmaSourceFromString(c.read_string(s, "sigma_source", toString(sigma_source)));
+	MRPT_LOAD_CONFIG_VAR(min_sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lm_max_iterations, int, c, s);
 	validate();
 }
@@ -60,6 +74,8 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 {
 	c.write(s, "method", toString(method), -1, -1, "ClosedForm (paper, level camera) | General6Dof (PnP)");
 	c.write(s, "sigma_px", sigma_px, -1, -1, "std. dev. of each component of P [px]");
+	c.write(s, "sigma_source", toString(sigma_source), -1, -1, "Fixed (sigma_px) | Detector (its corner_sigma_px)");
+	c.write(s, "min_sigma_px", min_sigma_px, -1, -1, "Detector: floor of the sigma of a component of P [px]");
 	c.write(s, "lm_max_iterations", lm_max_iterations, -1, -1, "General6Dof: LM iterations per refinement");
 }
 
@@ -95,6 +111,16 @@ Measurement measure(
 	m.reprojection_rms_px = g.solutions[0].rms_px;
 	m.ambiguity_ratio = g.ambiguity_ratio;
 	return m;
+}
+
+Measurement measure(
+	const Detection& detection, const CameraModel& camera, const LandmarkGeometry& geometry,
+	const PoseOptions& options)
+{
+	PoseOptions o = options;
+	if (o.sigma_source == SigmaSource::Detector && detection.quality.corner_sigma_px > 0)
+		o.sigma_px = std::max(o.min_sigma_px, detection.quality.corner_sigma_px / std::sqrt(2.0));
+	return measure(detection.corners, camera, geometry, o);
 }
 
 }  // namespace codemark::pose

@@ -6,6 +6,7 @@
  * either the paper's closed form or the general 6-DoF path.
  */
 #include <codemark/landmark/camera.h>
+#include <codemark/landmark/detection.h>
 #include <codemark/landmark/geometry.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/poses/CPose3D.h>
@@ -30,6 +31,23 @@ enum class PoseMethod
 	General6Dof
 };
 
+/** Where the corner noise comes from. */
+enum class SigmaSource
+{
+	/** PoseOptions::sigma_px for every measurement. */
+	Fixed,
+	/** The detector's own per-detection estimate
+	 * (DetectionQuality::corner_sigma_px, per corner coordinate; each
+	 * component of P then has corner_sigma_px / sqrt(2)), floored at
+	 * PoseOptions::min_sigma_px; sigma_px where the detector gives none. */
+	Detector
+};
+
+/** "Fixed" / "Detector" (case-insensitive on read). */
+std::string toString(SigmaSource s);
+/** Throws std::invalid_argument naming the accepted values. */
+SigmaSource sigmaSourceFromString(const std::string& name);
+
 /** "ClosedForm" / "General6Dof" (case-insensitive on read). */
 std::string toString(PoseMethod m);
 /** Throws std::invalid_argument naming the accepted values. */
@@ -50,6 +68,12 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * (C_P = diag(s^2, s^2, s^2, s^2)). Each corner coordinate then has
 	 * sqrt(2) * sigma_px, which the general path uses. */
 	double sigma_px = kDefaultSigmaPx;
+	/** ini key `sigma_source` = Fixed | Detector (the latter only through
+	 * measure(const Detection&, ...)). */
+	SigmaSource sigma_source = SigmaSource::Fixed;
+	/** With SigmaSource::Detector: the smallest sigma of a component of P
+	 * accepted from the detector [px] (a line fit can be over-confident). */
+	double min_sigma_px = 0.01;
 	/** General path: Levenberg-Marquardt iterations of each refinement. */
 	int lm_max_iterations = 30;
 
@@ -97,5 +121,11 @@ struct Measurement
 Measurement measure(
 	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options = PoseOptions());
+
+/** As measure() on \a detection's corners; with SigmaSource::Detector the
+ * corner noise is the detector's own estimate (see SigmaSource). */
+Measurement measure(
+	const Detection& detection, const CameraModel& camera, const LandmarkGeometry& geometry,
+	const PoseOptions& options = PoseOptions());
 
 }  // namespace codemark::pose
