@@ -521,6 +521,28 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 		row("heading [deg]", [](const MethodErrors& e, const CellResult&) { return e.theta_rad; }, {}, 180 / M_PI, 3);
 		const auto [nc, nr, d0, d1, d2] = row("mean NEES (3 dof)",
 			[](const MethodErrors& e, const CellResult&) { return e.nees; }, {}, 1, 2);
+		if (o.sigma_source == pose::SigmaSource::Fixed)
+		{
+			// NEES scales as 1 / sigma^2: the sigma_px that would make the
+			// region's mean NEES 3 (for calibrating the default).
+			double sum[2] = {0, 0};
+			int n[2] = {0, 0};
+			for (const auto& c : cells)
+			{
+				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+				const MethodErrors* e[2] = {&c.closed_form, &c.general};
+				for (int k = 0; k < 2; ++k)
+					if (e[k]->detected)
+					{
+						sum[k] += e[k]->nees;
+						++n[k];
+					}
+			}
+			s << "sigma_px for mean NEES 3:";
+			for (int k = 0; k < 2; ++k)
+				s << (k ? ", gen " : " cf ") << (n[k] ? fmt(o.sigma_px * std::sqrt(sum[k] / n[k] / 3), 4) : std::string("-"));
+			s << "\n";
+		}
 		{
 			double dx = 0, dy = 0, rms = 0, tdx = 0, tdy = 0, trms = 0;
 			int n = 0, tn = 0;
