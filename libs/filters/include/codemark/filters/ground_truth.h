@@ -1,0 +1,51 @@
+#pragma once
+/** \file ground_truth.h
+ * Ground-truth robot paths for codemark-localize --gt, in both forms of
+ * landmark-spec.md section 6:
+ *  - `timestamp x y yaw` rows (UNIX s, m, m, rad; `#` or `%` comments):
+ *    matched to steps by timestamp (codemark-simul's gt_path.txt);
+ *  - MRPT robot-path files, `x y z yaw pitch roll` rows with `%` comments
+ *    (e.g. kf-slam_demo's ground truth), whose row 0 is the start pose:
+ *    step i matches row i + 1.
+ */
+#include <mrpt/poses/CPose2D.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace codemark::filters
+{
+/** A loaded ground-truth path. */
+class GroundTruth
+{
+   public:
+	enum class Form
+	{
+		Timestamped,  //!< `timestamp x y yaw`
+		MrptPath  //!< `x y z yaw pitch roll`, step i = row i + 1
+	};
+
+	/** Reads \a path; the form is told by the number of columns of the first
+	 * data row (4 or 6). Throws std::runtime_error naming the file and line
+	 * on a bad row, a mix of forms, or when the file cannot be opened. */
+	static GroundTruth load(const std::string& path);
+
+	/** The true pose at step \a index with timestamp \a t [UNIX s]: by
+	 * timestamp (nearest row within \a tolerance_s) or by row index + 1.
+	 * None when there is no matching row. */
+	std::optional<mrpt::poses::CPose2D> poseAt(
+		long index, double t, double tolerance_s = 1e-3) const;
+
+	Form form() const { return form_; }
+	std::size_t size() const { return poses_.size(); }
+	/** Every pose of the file in order (for plots). */
+	const std::vector<mrpt::poses::CPose2D>& poses() const { return poses_; }
+
+   private:
+	Form form_ = Form::Timestamped;
+	std::vector<double> times_;  // Timestamped only, ascending
+	std::vector<mrpt::poses::CPose2D> poses_;
+};
+
+}  // namespace codemark::filters

@@ -1,0 +1,84 @@
+#pragma once
+/** \file outputs.h
+ * The logic of codemark-localize: read a rawlog step by step
+ * (RawlogStepper), run one filter (makeLocalizer), and write the outputs of
+ * landmark-spec.md section 6 into a folder: estimated_path.txt,
+ * estimated_path.tum, covariances.txt, map.txt and map_covariances.txt
+ * (SLAM), trajectory.png, trajectory.3Dscene, summary.json.
+ */
+#include <codemark/filters/localizer.h>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace codemark::filters
+{
+/** What to run. */
+struct LocalizeRequest
+{
+	std::string config_file;  //!< the method's ini (share/codemark/config/<method>.ini)
+	std::string rawlog;  //!< input rawlog (either format)
+	std::string map_file;  //!< landmark map (spec section 3) or MRPT landmark file; may be empty for SLAM
+	std::string method;  //!< ekf | ekf-pose | ekf-slam | pf; empty: the ini's [localize] method, else ekf
+	std::string gt_file;  //!< ground truth (either form of spec section 6); may be empty
+	std::string out_dir;  //!< output folder (created)
+};
+
+/** One processed camera frame. */
+struct PathRow
+{
+	long step = 0;
+	double timestamp = 0;  //!< UNIX s, or the step index
+	PoseEstimate estimate;
+	StepStats stats;
+	std::optional<mrpt::poses::CPose2D> truth;  //!< matched ground truth
+};
+
+/** Accuracy against ground truth over the initialised steps with a match. */
+struct PathMetrics
+{
+	int matched = 0;  //!< steps compared
+	double ate_rmse_m = 0;  //!< RMS of the position error [m]
+	double max_error_m = 0;  //!< largest position error [m]
+	double yaw_rmse_deg = 0;  //!< RMS of the wrapped yaw error [deg]
+	double nees_mean = 0;  //!< mean of e^T P^-1 e (3 DoF: x, y, yaw)
+	/** Two-sided 95% band of the mean NEES of a consistent filter:
+	 * chi2inv(0.025 / 0.975, 3 N) / N. */
+	double nees_band_low = 0, nees_band_high = 0;
+};
+
+/** What a run did. */
+struct LocalizeSummary
+{
+	std::string method;
+	long steps = 0;  //!< processed camera frames
+	long sightings_used = 0, sightings_rejected = 0, sightings_unknown_id = 0;
+	long reinitializations = 0;  //!< global initialisation and kidnap recoveries
+	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
+	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
+	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]
+	double detect_ms_per_image = 0;  //!< mean on-the-fly detection time [ms] (0: none)
+	std::optional<PathMetrics> metrics;  //!< with ground truth
+	std::vector<PathRow> rows;
+	std::vector<MappedLandmark> slam_map;  //!< SLAM only
+};
+
+/** Metrics of \a rows (those initialised and with truth); none matched: nullopt. */
+std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows);
+
+/** Runs the whole thing and writes the outputs. \a progress(fraction) is
+ * called after each step. Throws std::runtime_error / std::invalid_argument
+ * with one line naming the file, line or entry on bad input. */
+LocalizeSummary runLocalization(
+	const LocalizeRequest& request, const std::function<void(double)>& progress = {});
+
+/** Writes the output files of \a s into \a out_dir (created). \a map: the
+ * map used (drawn in the plot and the 3D scene). */
+void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::string& out_dir);
+
+/** summary.json's text. */
+std::string summaryJson(const LocalizeSummary& s);
+
+}  // namespace codemark::filters

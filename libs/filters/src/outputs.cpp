@@ -1,0 +1,371 @@
+// codemark-localize's logic: rawlog -> filter -> output files (spec section 6).
+#include <codemark/filters/ground_truth.h>
+#include <codemark/filters/mrpt_landmarks.h>
+#include <codemark/filters/outputs.h>
+#include <codemark/filters/stepper.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/math/distributions.h>
+#include <mrpt/math/wrap2pi.h>
+#include <mrpt/opengl/CEllipsoid2D.h>
+#include <mrpt/opengl/CGridPlaneXY.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPointCloud.h>
+#include <mrpt/opengl/CSetOfLines.h>
+#include <mrpt/opengl/CText.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace codemark::filters
+{
+namespace fs = std::filesystem;
+using mrpt::poses::CPose2D;
+
+std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows)
+{
+	PathMetrics m;
+	double se = 0, syaw = 0, snees = 0;
+	for (const auto& r : rows)
+	{
+		if (!r.estimate.initialized || !r.truth) continue;
+		const Eigen::Vector3d e(
+			r.estimate.mean.x() - r.truth->x(), r.estimate.mean.y() - r.truth->y(),
+			mrpt::math::wrapToPi(r.estimate.mean.phi() - r.truth->phi()));
+		const double d2 = e[0] * e[0] + e[1] * e[1];
+		se += d2;
+		syaw += e[2] * e[2];
+		m.max_error_m = std::max(m.max_error_m, std::sqrt(d2));
+		snees += e.dot(r.estimate.cov.ldlt().solve(e));
+		++m.matched;
+	}
+	if (m.matched == 0) return std::nullopt;
+	m.ate_rmse_m = std::sqrt(se / m.matched);
+	m.yaw_rmse_deg = std::sqrt(syaw / m.matched) * 180.0 / M_PI;
+	m.nees_mean = snees / m.matched;
+	const unsigned dof = 3u * static_cast<unsigned>(m.matched);
+	m.nees_band_low = mrpt::math::chi2inv(0.025, dof) / m.matched;
+	m.nees_band_high = mrpt::math::chi2inv(0.975, dof) / m.matched;
+	return m;
+}
+
+namespace
+{
+LandmarkMap loadAnyMap(const std::string& path)
+{
+	if (isMrptLandmarksFile(path)) return loadMrptLandmarksFile(path);
+	return LandmarkMap::load(path);
+}
+
+std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg)
+{
+	if (!cfg.read_bool("localize", "initial_pose_known", false)) return std::nullopt;
+	PoseEstimate e;
+	e.initialized = true;
+	e.mean = CPose2D(
+		cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
+		mrpt::DEG2RAD(cfg.read_double("localize", "initial_yaw_deg", 0)));
+	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
+	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
+	if (!(sxy > 0) || !(syaw > 0))
+		throw std::invalid_argument("[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
+	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+	return e;
+}
+
+std::string num(double v, int decimals = 6)
+{
+	if (!std::isfinite(v)) return "null";
+	std::ostringstream os;
+	os << std::fixed << std::setprecision(decimals) << v;
+	return os.str();
+}
+
+void writeTextFiles(const LocalizeSummary& s, const std::string& dir)
+{
+	std::ofstream path(dir + "/estimated_path.txt"), tum(dir + "/estimated_path.tum"),
+		cov(dir + "/covariances.txt");
+	if (!path || !tum || !cov) throw std::runtime_error(dir + ": cannot write the path files");
+	path << "# timestamp[UNIX s] x[m] y[m] yaw[rad]: robot pose in the map frame, one row per camera "
+			"frame from the first fix on (" << s.method << ")\n";
+	tum << "# timestamp tx ty tz qx qy qz qw (TUM format; z = 0, rotation about z)\n";
+	cov << "# timestamp then the 3x3 covariance of (x, y, yaw) row by row [m^2, m rad, rad^2]\n";
+	for (const auto& r : s.rows)
+	{
+		if (!r.estimate.initialized) continue;
+		const auto& p = r.estimate.mean;
+		const std::string t = num(r.timestamp, 6);
+		path << t << ' ' << num(p.x()) << ' ' << num(p.y()) << ' ' << num(p.phi()) << '\n';
+		tum << t << ' ' << num(p.x()) << ' ' << num(p.y()) << " 0 0 0 " << num(std::sin(p.phi() / 2), 9)
+			<< ' ' << num(std::cos(p.phi() / 2), 9) << '\n';
+		cov << t;
+		for (int i = 0; i < 3; ++i)
+			for (int j = 0; j < 3; ++j) cov << ' ' << std::setprecision(9) << std::scientific << r.estimate.cov(i, j);
+		cov << std::defaultfloat << '\n';
+	}
+	if (!s.slam_map.empty())
+	{
+		LandmarkMap m;
+		std::ofstream mc(dir + "/map_covariances.txt");
+		mc << "# id then the 3x3 covariance of the landmark's (x, y, yaw) row by row [m^2, m rad, rad^2]\n";
+		for (const auto& l : s.slam_map)
+		{
+			m.landmarks.push_back(l.landmark);
+			mc << l.landmark.id;
+			for (int i = 0; i < 3; ++i)
+				for (int j = 0; j < 3; ++j) mc << ' ' << std::setprecision(9) << std::scientific << l.cov(i, j);
+			mc << std::defaultfloat << '\n';
+		}
+		m.save(dir + "/map.txt");
+	}
+}
+
+// 2D plot: estimate (blue), ground truth (green), landmarks (black, with
+// their outward normals), 95% position ellipses (red) every N steps.
+void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::string& file)
+{
+	double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+	auto grow = [&](double x, double y) {
+		x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+	};
+	for (const auto& l : map.landmarks) grow(l.x_m, l.y_m);
+	for (const auto& l : s.slam_map) grow(l.landmark.x_m, l.landmark.y_m);
+	for (const auto& r : s.rows)
+	{
+		if (r.estimate.initialized) grow(r.estimate.mean.x(), r.estimate.mean.y());
+		if (r.truth) grow(r.truth->x(), r.truth->y());
+	}
+	if (x0 > x1) x0 = y0 = -1, x1 = y1 = 1;
+	const double margin = 0.5;
+	x0 -= margin, y0 -= margin, x1 += margin, y1 += margin;
+	const int W = 1000;
+	const double scale = W / std::max(x1 - x0, 1e-3);
+	const int H = std::clamp(static_cast<int>((y1 - y0) * scale), 100, 4000);
+	cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+	auto px = [&](double x, double y) {
+		return cv::Point(static_cast<int>((x - x0) * scale), static_cast<int>(H - (y - y0) * scale));
+	};
+	for (int g = static_cast<int>(std::ceil(x0)); g <= x1; ++g)
+		cv::line(img, px(g, y0), px(g, y1), cv::Scalar(230, 230, 230));
+	for (int g = static_cast<int>(std::ceil(y0)); g <= y1; ++g)
+		cv::line(img, px(x0, g), px(x1, g), cv::Scalar(230, 230, 230));
+	auto drawLandmark = [&](const MapLandmark& l, const cv::Scalar& c) {
+		cv::circle(img, px(l.x_m, l.y_m), 4, c, cv::FILLED, cv::LINE_AA);
+		cv::line(img, px(l.x_m, l.y_m),
+			px(l.x_m + 0.25 * std::cos(l.yaw_rad), l.y_m + 0.25 * std::sin(l.yaw_rad)), c, 1, cv::LINE_AA);
+		cv::putText(img, std::to_string(l.id), px(l.x_m, l.y_m) + cv::Point(5, -5),
+			cv::FONT_HERSHEY_SIMPLEX, 0.4, c, 1, cv::LINE_AA);
+	};
+	for (const auto& l : map.landmarks) drawLandmark(l, cv::Scalar(0, 0, 0));
+	for (const auto& l : s.slam_map) drawLandmark(l.landmark, cv::Scalar(160, 0, 160));
+	std::vector<cv::Point> est, gt;
+	for (const auto& r : s.rows)
+	{
+		if (r.estimate.initialized) est.push_back(px(r.estimate.mean.x(), r.estimate.mean.y()));
+		if (r.truth) gt.push_back(px(r.truth->x(), r.truth->y()));
+	}
+	if (gt.size() > 1) cv::polylines(img, gt, false, cv::Scalar(0, 160, 0), 2, cv::LINE_AA);
+	if (est.size() > 1) cv::polylines(img, est, false, cv::Scalar(200, 0, 0), 1, cv::LINE_AA);
+	const long every = std::max<long>(1, static_cast<long>(s.rows.size()) / 40);
+	const double k95 = std::sqrt(mrpt::math::chi2inv(0.95, 2));
+	for (std::size_t i = 0; i < s.rows.size(); i += every)
+	{
+		const auto& e = s.rows[i].estimate;
+		if (!e.initialized) continue;
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(e.cov.block<2, 2>(0, 0));
+		const Eigen::Vector2d ev = es.eigenvalues().cwiseMax(0.0);
+		const Eigen::Vector2d v = es.eigenvectors().col(1);
+		const double ang = std::atan2(v[1], v[0]) * 180.0 / M_PI;
+		const cv::Size axes(
+			std::max(1, static_cast<int>(k95 * std::sqrt(ev[1]) * scale)),
+			std::max(1, static_cast<int>(k95 * std::sqrt(ev[0]) * scale)));
+		cv::ellipse(img, px(e.mean.x(), e.mean.y()), axes, -ang, 0, 360, cv::Scalar(0, 0, 220), 1, cv::LINE_AA);
+	}
+	cv::putText(img, s.method + ": estimate (blue), ground truth (green), 95% ellipses (red), 1 m grid",
+		cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+	if (!cv::imwrite(file, img)) throw std::runtime_error(file + ": cannot write");
+}
+
+void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::string& file)
+{
+	mrpt::opengl::COpenGLScene scene;
+	scene.insert(mrpt::opengl::CGridPlaneXY::Create(-10, 10, -10, 10, 0, 1));
+	auto est = mrpt::opengl::CSetOfLines::Create();
+	est->setColor(0, 0, 0.8);
+	est->setLineWidth(2);
+	auto gt = mrpt::opengl::CSetOfLines::Create();
+	gt->setColor(0, 0.6, 0);
+	bool have_est = false, have_gt = false;
+	const PathRow* prev = nullptr;
+	const long every = std::max<long>(1, static_cast<long>(s.rows.size()) / 40);
+	for (std::size_t i = 0; i < s.rows.size(); ++i)
+	{
+		const auto& r = s.rows[i];
+		if (prev && prev->estimate.initialized && r.estimate.initialized)
+		{
+			est->appendLine(prev->estimate.mean.x(), prev->estimate.mean.y(), 0.01, r.estimate.mean.x(),
+				r.estimate.mean.y(), 0.01);
+			have_est = true;
+		}
+		if (prev && prev->truth && r.truth)
+		{
+			gt->appendLine(prev->truth->x(), prev->truth->y(), 0.0, r.truth->x(), r.truth->y(), 0.0);
+			have_gt = true;
+		}
+		if (r.estimate.initialized && i % every == 0)
+		{
+			auto ell = mrpt::opengl::CEllipsoid2D::Create();
+			mrpt::math::CMatrixDouble22 C;
+			C.asEigen() = r.estimate.cov.block<2, 2>(0, 0);
+			ell->setCovMatrix(C);
+			ell->setQuantiles(std::sqrt(mrpt::math::chi2inv(0.95, 2)));
+			ell->setLocation(r.estimate.mean.x(), r.estimate.mean.y(), 0.02);
+			ell->setColor(0.9, 0, 0);
+			scene.insert(ell);
+		}
+		prev = &r;
+	}
+	if (have_est) scene.insert(est);
+	if (have_gt) scene.insert(gt);
+	auto lms = mrpt::opengl::CPointCloud::Create();
+	lms->setPointSize(8);
+	lms->setColor(0, 0, 0);
+	auto addLandmark = [&](const MapLandmark& l) {
+		lms->insertPoint(l.x_m, l.y_m, l.z_m);
+		auto t = mrpt::opengl::CText::Create(std::to_string(l.id));
+		t->setLocation(l.x_m, l.y_m, l.z_m + 0.1);
+		scene.insert(t);
+	};
+	for (const auto& l : map.landmarks) addLandmark(l);
+	for (const auto& l : s.slam_map) addLandmark(l.landmark);
+	scene.insert(lms);
+	mrpt::io::CFileGZOutputStream f;
+	if (!f.open(file)) throw std::runtime_error(file + ": cannot write");
+	auto ar = mrpt::serialization::archiveFrom(f);
+	ar << scene;
+}
+}  // namespace
+
+std::string summaryJson(const LocalizeSummary& s)
+{
+	std::ostringstream o;
+	o << "{\n";
+	o << "  \"method\": \"" << s.method << "\",\n";
+	o << "  \"steps\": " << s.steps << ",\n";
+	o << "  \"sightings_used\": " << s.sightings_used << ",\n";
+	o << "  \"sightings_rejected\": " << s.sightings_rejected << ",\n";
+	o << "  \"sightings_unknown_id\": " << s.sightings_unknown_id << ",\n";
+	o << "  \"reinitializations\": " << s.reinitializations << ",\n";
+	o << "  \"first_fix_step\": " << s.first_fix_step << ",\n";
+	o << "  \"first_fix_time_s\": " << num(s.first_fix_time_s, 3) << ",\n";
+	o << "  \"detect_ms_per_image\": " << num(s.detect_ms_per_image, 3) << ",\n";
+	if (s.metrics)
+	{
+		const auto& m = *s.metrics;
+		o << "  \"gt_matched_steps\": " << m.matched << ",\n";
+		o << "  \"ate_rmse_m\": " << num(m.ate_rmse_m, 6) << ",\n";
+		o << "  \"max_error_m\": " << num(m.max_error_m, 6) << ",\n";
+		o << "  \"yaw_rmse_deg\": " << num(m.yaw_rmse_deg, 4) << ",\n";
+		o << "  \"nees_mean\": " << num(m.nees_mean, 4) << ",\n";
+		o << "  \"nees_band_95\": [" << num(m.nees_band_low, 4) << ", " << num(m.nees_band_high, 4) << "],\n";
+	}
+	o << "  \"time_per_step_ms\": " << num(s.time_per_step_ms, 4) << "\n";
+	o << "}\n";
+	return o.str();
+}
+
+void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::string& dir)
+{
+	std::error_code ec;
+	fs::create_directories(dir, ec);
+	if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": cannot create output directory");
+	writeTextFiles(s, dir);
+	writePlot(s, map, dir + "/trajectory.png");
+	writeScene(s, map, dir + "/trajectory.3Dscene");
+	std::ofstream j(dir + "/summary.json");
+	if (!j) throw std::runtime_error(dir + "/summary.json: cannot write");
+	j << summaryJson(s);
+}
+
+LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<void(double)>& progress)
+{
+	if (!std::ifstream(req.config_file).good())
+		throw std::runtime_error(req.config_file + ": cannot open config file");
+	mrpt::config::CConfigFile cfg(req.config_file);
+	LocalizeSummary s;
+	s.method = !req.method.empty() ? req.method : cfg.read_string("localize", "method", "ekf");
+	const bool slam = s.method == "ekf-slam";
+	LandmarkMap map;
+	if (!req.map_file.empty()) map = loadAnyMap(req.map_file);
+	else if (!slam)
+		throw std::invalid_argument("method '" + s.method + "' needs a landmark map (--map)");
+	std::optional<GroundTruth> gt;
+	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
+
+	StepperOptions so;
+	so.loadFromConfigFile(cfg, "stepper");
+	pipeline::PipelineOptions po;
+	po.detector.loadFromConfigFile(cfg, "detector");
+	po.pose.loadFromConfigFile(cfg, "pose");
+	if (!req.map_file.empty() && !isMrptLandmarksFile(req.map_file)) po.map = map;
+
+	auto filter = makeLocalizer(s.method, cfg, map, initialPose(cfg));
+	RawlogStepper stepper(req.rawlog, so, po);
+	RawlogStep step;
+	double filter_s = 0;
+	double first_t = 0;
+	long images = 0;
+	double detect_s = 0;
+	auto t_read = std::chrono::steady_clock::now();
+	while (true)
+	{
+		const bool more = stepper.next(step);
+		const auto t0 = std::chrono::steady_clock::now();
+		if (!more) break;
+		if (step.images_detected > 0)
+		{
+			images += step.images_detected;
+			detect_s += std::chrono::duration<double>(t0 - t_read).count();
+		}
+		const StepStats st = filter->step(step.odometry.get(), step.observations);
+		const auto t1 = std::chrono::steady_clock::now();
+		filter_s += std::chrono::duration<double>(t1 - t0).count();
+		PathRow row;
+		row.step = step.index;
+		row.timestamp = step.timestamp;
+		row.estimate = filter->estimate();
+		row.stats = st;
+		if (gt) row.truth = gt->poseAt(step.index, step.timestamp);
+		if (step.index == 0) first_t = step.timestamp;
+		if (row.estimate.initialized && s.first_fix_step < 0)
+		{
+			s.first_fix_step = step.index;
+			s.first_fix_time_s = step.timestamp - first_t;
+		}
+		s.sightings_used += st.used;
+		s.sightings_rejected += st.rejected;
+		s.sightings_unknown_id += st.unknown_id;
+		s.reinitializations += st.reinitialized ? 1 : 0;
+		s.rows.push_back(std::move(row));
+		++s.steps;
+		if (progress) progress(stepper.progress());
+		t_read = std::chrono::steady_clock::now();
+	}
+	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
+	s.detect_ms_per_image = images ? 1000.0 * detect_s / images : 0.0;
+	s.slam_map = filter->landmarks();
+	s.metrics = computeMetrics(s.rows);
+	if (!req.out_dir.empty()) writeOutputs(s, map, req.out_dir);
+	return s;
+}
+
+}  // namespace codemark::filters
