@@ -33,7 +33,9 @@ std::optional<double> locateRisingEdge(
 			const double den = la - 2 * lb + lc;
 			if (den < 0) return peak + std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
 		}
-		return peak;
+		// A plain parabola where the logarithm is undefined.
+		const double den = a - 2.0 * dp + c;
+		return den < 0 ? peak + std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : double(peak);
 	}
 	// The response of a blurred step: sum the derivative while it stays
 	// positive and above a fraction of the peak; its centroid is the edge
@@ -137,7 +139,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 	const Eigen::Vector2d centre = 0.25 * (coarse[0] + coarse[1] + coarse[2] + coarse[3]);
 	const int W = bgr.cols, H = bgr.rows;
 	const int half = p.search_px + p.reach_px + 2;
-	std::vector<int> prof(2 * half + 1), prof_rb(2 * half + 1);
 	for (int side = 0; side < 4; ++side)
 	{
 		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
@@ -162,73 +163,81 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const EdgeMode mode = frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
 		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
 		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
-		std::vector<Eigen::Vector2d> pts;
-		pts.reserve(static_cast<size_t>(std::max(0.0, s1 - s0)) + 1);
+		// First pass: read the profiles (G and -(R + B), across the side,
+		// pointing into the fill).
+		const int n = 2 * half + 1;
+		const int lo = half - p.search_px, hi = half + p.search_px;
+		std::vector<int> g_prof, rb_prof, pos, origin;
+		int saturated = 0, heavy = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
 			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
 			const int c0 = static_cast<int>(std::lround(cpred));
 			// Profile index i <-> across coordinate c0 + inward * (i - half).
-			if (along == 1)
-			{
-				if (s < 0 || s >= H) continue;
-				const uint8_t* row = bgr.ptr<uint8_t>(s);
-				bool inside = true;
-				for (int i = 0; i <= 2 * half; ++i)
-				{
-					const int u = c0 + inward * (i - half);
-					if (u < 0 || u >= W) { inside = false; break; }
-					prof[i] = row[3 * u + 1];
-					prof_rb[i] = -(row[3 * u] + row[3 * u + 2]);
-				}
-				if (!inside) continue;
-			}
-			else
-			{
-				if (s < 0 || s >= W) continue;
-				bool inside = true;
-				for (int i = 0; i <= 2 * half; ++i)
-				{
-					const int v = c0 + inward * (i - half);
-					if (v < 0 || v >= H) { inside = false; break; }
-					const uint8_t* px = bgr.ptr<uint8_t>(v) + 3 * s;
-					prof[i] = px[1];
-					prof_rb[i] = -(px[0] + px[2]);
-				}
-				if (!inside) continue;
-			}
-			// G saturates on bright fills (the sensor clips at 255), which
-			// cuts the response on the bright side and pulls its centroid
-			// towards the frame. The edge is then found in R + B, dark in the
-			// green fill and unsaturated in the black frame, or failing that
-			// at the G derivative's peak. Saturated: the fill side of the
-			// profile averages above saturation_level (noise around a fill of
-			// exactly 255 does not count).
-			const int n = static_cast<int>(prof.size());
-			const int lo = half - p.search_px, hi = half + p.search_px;
+			const int c_first = c0 - half, c_last = c0 + half;
+			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H)) continue;
 			double fill_sum = 0;
-			for (int i = hi + 2; i < n; ++i) fill_sum += prof[i];
+			const size_t first = g_prof.size();
+			for (int i = 0; i < n; ++i)
+			{
+				const int c = c0 + inward * (i - half);
+				const uint8_t* px = along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
+				g_prof.push_back(px[1]);
+				rb_prof.push_back(-(px[0] + px[2]));
+				if (i >= hi + 2) fill_sum += px[1];
+			}
+			if (fill_sum >= p.saturation_level * (n - hi - 2))
+			{
+				++saturated;
+				// Heavily: the profile clips right after its steepest point.
+				const int* gp = g_prof.data() + first;
+				int k = lo;
+				for (int i = lo + 1; i <= hi; ++i)
+					if (gp[i + 1] - gp[i - 1] > gp[k + 1] - gp[k - 1]) k = i;
+				heavy += gp[k + 1] >= 254;
+			}
+			pos.push_back(s);
+			origin.push_back(c0);
+		}
+		// G saturates on bright fills (the sensor clips at 255), which cuts
+		// the response on the bright side and pulls its centroid towards the
+		// frame. A side is saturated when most of its profiles' fill sides
+		// average above saturation_level (noise around a fill of exactly 255
+		// does not count): its edges are then at the G derivative's peak,
+		// which mild clipping (above the step's middle) leaves in place. When
+		// most profiles clip right after their steepest point, not even the
+		// peak is seen: the edge is found in R + B (dark in the green fill,
+		// unsaturated in the black frame). One estimator per side: mixing
+		// them would split the points into two populations.
+		const int half_count = static_cast<int>(pos.size()) / 2;
+		const bool side_saturated = saturated > half_count;
+		const bool side_heavy = heavy > half_count;
+		std::vector<Eigen::Vector2d> pts;
+		pts.reserve(pos.size());
+		for (size_t j = 0; j < pos.size(); ++j)
+		{
+			const int* gp = g_prof.data() + j * n;
+			const int* rbp = rb_prof.data() + j * n;
 			std::optional<double> e;
-			if (fill_sum < p.saturation_level * (n - hi - 2))
-				e = locateRisingEdge(prof.data(), n, lo, hi, min_rise, p, mode);
+			if (!side_saturated)
+				e = locateRisingEdge(gp, n, lo, hi, min_rise, p, mode);
 			else
 			{
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.
-				const auto g_peak = locateRisingEdge(prof.data(), n, lo, hi, min_rise, p, EdgeMode::Peak);
+				const auto g_peak = locateRisingEdge(gp, n, lo, hi, min_rise, p, EdgeMode::Peak);
 				if (g_peak)
 				{
 					const int k = static_cast<int>(std::lround(*g_peak));
-					if (mode == EdgeMode::Centroid)
-						e = locateRisingEdge(
-							prof_rb.data(), n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
+					if (side_heavy && mode == EdgeMode::Centroid)
+						e = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
 					if (!e) e = g_peak;
 				}
 			}
 			if (!e) continue;
-			const double c = c0 + inward * (*e - half);
-			Eigen::Vector2d pt = along == 1 ? Eigen::Vector2d(c, s) : Eigen::Vector2d(s, c);
+			const double c = origin[j] + inward * (*e - half);
+			Eigen::Vector2d pt = along == 1 ? Eigen::Vector2d(c, pos[j]) : Eigen::Vector2d(pos[j], c);
 			// Lines are straight only without distortion: fit undistorted.
 			if (distorted) pt = cam.undistortPixel(pt);
 			pts.push_back(pt);
