@@ -1,0 +1,249 @@
+/** \file main.cpp
+ * codemark-detect: runs the landmark detector on images, folders of images
+ * and videos, and prints one JSON object per image (landmark-spec.md
+ * section 5). Parses the command line and calls codemark::detect::detect().
+ */
+#include <codemark/detect/detector.h>
+#include <codemark/detect/json.h>
+#include <codemark/landmark/camera.h>
+#include <mrpt/config/CConfigFile.h>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <tclap/CmdLine.h>
+
+#include <algorithm>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace codemark;
+
+namespace
+{
+const std::vector<std::string> kImageExt = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"};
+const std::vector<std::string> kVideoExt = {".mp4", ".avi", ".mkv", ".mov", ".webm", ".mpg", ".mpeg", ".m4v"};
+
+std::string lowerExt(const fs::path& p)
+{
+	std::string e = p.extension().string();
+	std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+	return e;
+}
+
+bool hasExt(const fs::path& p, const std::vector<std::string>& exts)
+{
+	return std::find(exts.begin(), exts.end(), lowerExt(p)) != exts.end();
+}
+
+/** A name safe for a file: path separators and '#' replaced. */
+std::string flatName(const std::string& s)
+{
+	std::string out = s;
+	for (char& c : out)
+		if (c == '/' || c == '\\' || c == '#' || c == ':') c = '_';
+	while (!out.empty() && out[0] == '.') out.erase(0, 1);
+	return out.empty() ? "image" : out;
+}
+
+struct Runner
+{
+	CameraModel camera;
+	LandmarkGeometry geometry;
+	detect::DetectorOptions options;
+	std::string draw_dir, debug_dir;
+	bool warned_size = false;
+	int failures = 0;
+
+	void fail(const std::string& name, const std::string& why)
+	{
+		std::cout << detect::errorToJson(name, why) << std::endl;
+		++failures;
+	}
+
+	void process(const std::string& name, const cv::Mat& img)
+	{
+		if (img.empty() || img.type() != CV_8UC3)
+		{
+			fail(name, "not a colour image");
+			return;
+		}
+		if (!warned_size && (img.cols != camera.width() || img.rows != camera.height()))
+		{
+			std::cerr << "warning: " << name << " is " << img.cols << "x" << img.rows << " but the camera is "
+					  << camera.width() << "x" << camera.height() << "; P uses the camera's intrinsics as given\n";
+			warned_size = true;
+		}
+		std::string dbg;
+		if (!debug_dir.empty())
+		{
+			dbg = (fs::path(debug_dir) / flatName(name)).string();
+			fs::create_directories(dbg);
+		}
+		const auto res = detect::detect(img, camera, geometry, options, dbg);
+		std::cout << detect::imageToJson(name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks)
+				  << std::endl;
+		if (!draw_dir.empty())
+		{
+			cv::Mat ov = img.clone();
+			detect::drawDetections(ov, res.landmarks);
+			const std::string out = (fs::path(draw_dir) / (flatName(name) + ".png")).string();
+			if (!cv::imwrite(out, ov)) std::cerr << "warning: cannot write " << out << "\n";
+		}
+	}
+
+	void image(const std::string& path)
+	{
+		cv::Mat img;
+		try
+		{
+			img = cv::imread(path, cv::IMREAD_COLOR);
+		}
+		catch (const std::exception& e)
+		{
+			fail(path, std::string("cannot read the image: ") + e.what());
+			return;
+		}
+		if (img.empty())
+		{
+			fail(path, "cannot read the image (missing, unreadable or not an image)");
+			return;
+		}
+		process(path, img);
+	}
+
+	void video(const std::string& path)
+	{
+		cv::VideoCapture cap(path);
+		if (!cap.isOpened())
+		{
+			fail(path, "cannot open the video");
+			return;
+		}
+		cv::Mat frame;
+		for (int i = 0;; ++i)
+		{
+			if (!cap.read(frame) || frame.empty())
+			{
+				if (i == 0) fail(path, "the video has no readable frame");
+				break;
+			}
+			cv::Mat bgr = frame;
+			if (frame.channels() == 1) cv::cvtColor(frame, bgr, cv::COLOR_GRAY2BGR);
+			process(path + "#" + std::to_string(i), bgr);
+		}
+	}
+
+	void input(const std::string& arg)
+	{
+		std::error_code ec;
+		if (fs::is_directory(arg, ec))
+		{
+			std::vector<fs::path> files;
+			for (const auto& e : fs::directory_iterator(arg, ec))
+				if (e.is_regular_file() && hasExt(e.path(), kImageExt)) files.push_back(e.path());
+			std::sort(files.begin(), files.end());
+			if (files.empty()) std::cerr << "warning: no image in folder " << arg << "\n";
+			for (const auto& f : files) image(f.string());
+		}
+		else if (hasExt(arg, kVideoExt))
+			video(arg);
+		else
+			image(arg);
+	}
+};
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	try
+	{
+		TCLAP::CmdLine cmd(
+			"Detects coded landmarks (landmark-spec.md) in images with the detector of Baczyk, "
+			"Kasinski and Skrzypczynski (2003) and prints one JSON object per image on its own "
+			"line (spec section 5): {\"image\", \"width\", \"height\", \"time_ms\", \"detections\": "
+			"[{\"id\", \"corners\" (inner frame corners in raw pixels, TL TR BR BL as they appear in "
+			"the image, pixel (0,0) at the centre of the top-left pixel), \"P\" ([x1 y1 x2 y2] from "
+			"the undistorted corners)}]}. time_ms is the detector's own time, without file "
+			"decoding. An input that cannot be read gives {\"image\", \"error\"} and the run goes "
+			"on; the exit code is 1 at the end if any input failed.",
+			' ', "0.1.0");
+		TCLAP::ValueArg<std::string> camera_arg("", "camera",
+			"Camera intrinsics: MRPT [CAMERA_PARAMS] ini (.ini/.cfg/.txt, e.g. from camera-calib) or "
+			"ROS/OpenCV calibration YAML (.yaml/.yml). Distortion is taken into account for the "
+			"line fits and P. Default: share/codemark/camera-paper.ini (640x480, fx = fy = 800).",
+			false, "", "CAM", cmd);
+		TCLAP::ValueArg<std::string> landmark_arg("", "landmark",
+			"Landmark sizes: ini file with a [LANDMARK] section (share/codemark/landmark.ini). "
+			"Only the proportions matter to the detector. Default: the spec's A4 landmark.",
+			false, "", "LM.ini", cmd);
+		TCLAP::ValueArg<std::string> config_arg("", "config",
+			"Detector parameters: ini file with a [DETECTOR] section (share/codemark/detector.ini "
+			"lists every parameter with its default and unit). Default: the built-in defaults.",
+			false, "", "detector.ini", cmd);
+		TCLAP::ValueArg<std::string> draw_arg("", "draw",
+			"Folder (created when missing) that receives one overlay PNG per image: the "
+			"detected frame, corners (top-left marked), ID and the landmark's axes.",
+			false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> debug_arg("", "debug-dir",
+			"Folder (created when missing) that receives per image a sub-folder with the "
+			"detector's stage images: colour mask, components, edgels, fitted lines, overlay.",
+			false, "", "DIR", cmd);
+		TCLAP::UnlabeledMultiArg<std::string> inputs_arg("inputs",
+			"Image files, folders (every image inside, sorted by name; not recursive) or video "
+			"files (.mp4, .avi, .mkv, ...; frames named VIDEO#N, N from 0).",
+			true, "INPUT", cmd);
+		cmd.parse(argc, argv);
+
+		// Single-threaded: time_ms is the detector's own, comparable figure.
+		cv::setNumThreads(1);
+		Runner r;
+		r.camera = camera_arg.isSet() ? CameraModel::load(camera_arg.getValue()) : CameraModel::paperDefault();
+		if (landmark_arg.isSet())
+		{
+			const std::string& path = landmark_arg.getValue();
+			if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot open the landmark file");
+			mrpt::config::CConfigFile cfg(path);
+			if (!cfg.sectionExists("LANDMARK")) throw std::runtime_error(path + ": no [LANDMARK] section");
+			try
+			{
+				r.geometry.loadFromConfigFile(cfg, "LANDMARK");
+			}
+			catch (const std::exception& e)
+			{
+				throw std::runtime_error(path + ": " + e.what());
+			}
+		}
+		if (config_arg.isSet()) r.options = detect::DetectorOptions::load(config_arg.getValue());
+		r.draw_dir = draw_arg.getValue();
+		r.debug_dir = debug_arg.getValue();
+		if (!r.draw_dir.empty()) fs::create_directories(r.draw_dir);
+		if (!r.debug_dir.empty()) fs::create_directories(r.debug_dir);
+		// Warm up once, so that the first image's time_ms does not carry
+		// OpenCV's one-time initialisation and the detector's colour table.
+		{
+			cv::Mat warm(64, 64, CV_8UC3, cv::Scalar(235, 235, 235));
+			cv::rectangle(warm, cv::Rect(12, 12, 40, 40), cv::Scalar(25, 25, 25), cv::FILLED);
+			cv::rectangle(warm, cv::Rect(16, 16, 32, 32), cv::Scalar(0, 255, 0), cv::FILLED);
+			detect::detect(warm, r.camera, r.geometry, r.options);
+		}
+		for (const auto& in : inputs_arg.getValue()) r.input(in);
+		return r.failures ? 1 : 0;
+	}
+	catch (const TCLAP::ArgException& e)
+	{
+		std::cerr << "error: " << e.error() << " for " << e.argId() << "\n";
+		return 2;
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "error: " << e.what() << "\n";
+		return 1;
+	}
+}
