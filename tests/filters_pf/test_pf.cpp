@@ -1,0 +1,382 @@
+// The coded-landmark map (CCodedLandmarksMap) and the particle filter.
+#include <codemark/filters/particle_filter.h>
+#include <codemark/mrpt/CCodedLandmarksMap.h>
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/io/vector_loadsave.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/opengl/CSetOfObjects.h>
+#include <mrpt/serialization/CArchive.h>
+#include <mrpt/system/filesystem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "synthetic.h"
+
+using codemark::CCodedLandmarksMap;
+using codemark::CObservationCodedLandmarks;
+using mrpt::poses::CPose2D;
+using mrpt::poses::CPose3D;
+namespace pft = codemark::pftest;
+
+namespace
+{
+double loglik(const CCodedLandmarksMap& m, const mrpt::obs::CObservation& o, const CPose2D& p)
+{
+	return m.computeObservationLikelihood(o, CPose3D(p));
+}
+
+std::vector<uint8_t> toBytes(const CCodedLandmarksMap& m)
+{
+	mrpt::io::CMemoryStream mem;
+	auto ar = mrpt::serialization::archiveFrom(mem);
+	ar << m;
+	const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
+	return {p, p + mem.getTotalBytesCount()};
+}
+
+mrpt::serialization::CSerializable::Ptr fromBytes(const std::vector<uint8_t>& b)
+{
+	mrpt::io::CMemoryStream mem;
+	mem.assignMemoryNotOwn(b.data(), b.size());
+	auto ar = mrpt::serialization::archiveFrom(mem);
+	return ar.ReadObject();
+}
+
+/** The shipped pf.ini with a fixed seed. */
+mrpt::config::CConfigFileMemory shippedConfig(int seed)
+{
+	mrpt::config::CConfigFileMemory cfg(
+		mrpt::io::file_get_contents(std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/pf.ini"));
+	cfg.write("ParticleFilter", "random_seed", seed);
+	return cfg;
+}
+
+double positionError(const codemark::filters::PoseEstimate& e, const CPose2D& truth)
+{
+	return std::hypot(e.mean.x() - truth.x(), e.mean.y() - truth.y());
+}
+
+/** A pose from which the room's landmarks are in view. */
+const CPose2D kPose(2.2, 1.7, 0.3);
+}  // namespace
+
+// ------------------------------------------------------------------- map
+TEST(CodedLandmarksMap, PredictedLMatchesTheTruth)
+{
+	const auto map = pft::room();
+	for (int k = 0; k < 80; k += 7)
+	{
+		const CPose2D p = pft::circlePose(k);
+		const auto o = pft::observe(p, map);
+		ASSERT_FALSE(o->sightings.empty()) << "step " << k;
+		double cx, cy, cc, cs;
+		ASSERT_TRUE(CCodedLandmarksMap::cameraInWorld(
+			p.x(), p.y(), std::cos(p.phi()), std::sin(p.phi()), o->cameraPose, cx, cy, cc, cs));
+		for (const auto& s : o->sightings)
+		{
+			const auto* lm = map.find(s.id);
+			const Eigen::Vector3d Lp = CCodedLandmarksMap::predictL(
+				cx, cy, cc, cs, lm->x_m, lm->y_m, std::cos(lm->yaw_rad), std::sin(lm->yaw_rad));
+			EXPECT_NEAR(Lp[0], s.L[0], 1e-9);
+			EXPECT_NEAR(Lp[1], s.L[1], 1e-9);
+			EXPECT_NEAR(Lp[2], s.L[2], 1e-9);
+		}
+	}
+}
+
+TEST(CodedLandmarksMap, SerializationRoundTrip)
+{
+	CCodedLandmarksMap m(pft::room());
+	m.likelihoodOptions.outlier_probability = 0.125;
+	m.likelihoodOptions.sigma_scale = 2.5;
+	m.likelihoodOptions.max_range_m = 12;
+	auto lms = m.landmarks();
+	lms.landmarks[3].scale = 0.5;
+	m.setLandmarks(lms);
+	for (const CCodedLandmarksMap& in : {CCodedLandmarksMap(), m})
+	{
+		const auto obj = fromBytes(toBytes(in));
+		const auto out = std::dynamic_pointer_cast<CCodedLandmarksMap>(obj);
+		ASSERT_TRUE(out);
+		ASSERT_EQ(out->landmarks().landmarks.size(), in.landmarks().landmarks.size());
+		for (size_t i = 0; i < in.landmarks().landmarks.size(); ++i)
+		{
+			const auto &a = in.landmarks().landmarks[i], &b = out->landmarks().landmarks[i];
+			EXPECT_EQ(a.id, b.id);
+			EXPECT_EQ(a.x_m, b.x_m);
+			EXPECT_EQ(a.y_m, b.y_m);
+			EXPECT_EQ(a.z_m, b.z_m);
+			EXPECT_EQ(a.yaw_rad, b.yaw_rad);
+			EXPECT_EQ(a.scale, b.scale);
+			EXPECT_EQ(out->find(a.id), &b);
+		}
+		EXPECT_EQ(out->likelihoodOptions.outlier_probability, in.likelihoodOptions.outlier_probability);
+		EXPECT_EQ(out->likelihoodOptions.sigma_scale, in.likelihoodOptions.sigma_scale);
+		EXPECT_EQ(out->likelihoodOptions.max_range_m, in.likelihoodOptions.max_range_m);
+	}
+}
+
+TEST(CodedLandmarksMap, UnknownVersionThrows)
+{
+	auto b = toBytes(CCodedLandmarksMap(pft::room()));
+	// MRPT's object header: 0x80|len, class name, version byte.
+	const std::string name = "codemark::CCodedLandmarksMap";
+	const auto it = std::search(b.begin(), b.end(), name.begin(), name.end());
+	ASSERT_NE(it, b.end());
+	EXPECT_NO_THROW(fromBytes(b));
+	*(it + static_cast<std::ptrdiff_t>(name.size())) = 99;
+	EXPECT_ANY_THROW(fromBytes(b));
+}
+
+TEST(CodedLandmarksMap, BuiltFromIniByMultiMetricMap)
+{
+	const std::string file = mrpt::system::getTempFileName() + "_map.txt";
+	pft::room().save(file);
+	mrpt::config::CConfigFileMemory cfg;
+	cfg.write("MetricMap", "codedLandmarksMap_count", 1);
+	cfg.write("MetricMap_codedLandmarksMap_00_creationOpts", "map_file", file);
+	cfg.write("MetricMap_codedLandmarksMap_00_likelihoodOpts", "outlier_probability", 0.2);
+	mrpt::maps::TSetOfMetricMapInitializers inits;
+	inits.loadFromConfigFile(cfg, "MetricMap");
+	ASSERT_EQ(inits.size(), 1u);
+	mrpt::maps::CMultiMetricMap mm;
+	mm.setListOfMaps(inits);
+	const auto m = mm.mapByClass<CCodedLandmarksMap>();
+	ASSERT_TRUE(m);
+	EXPECT_EQ(m->landmarks().landmarks.size(), pft::room().landmarks.size());
+	ASSERT_TRUE(m->find(7));
+	EXPECT_DOUBLE_EQ(m->find(7)->x_m, pft::room().find(7)->x_m);
+	EXPECT_DOUBLE_EQ(m->likelihoodOptions.outlier_probability, 0.2);
+	// The multi-map sums our likelihood: it must peak at the truth too.
+	const auto o = pft::observe(kPose, pft::room());
+	EXPECT_GT(
+		mm.computeObservationLikelihood(*o, CPose3D(kPose)),
+		mm.computeObservationLikelihood(*o, CPose3D(CPose2D(kPose.x() + 0.1, kPose.y(), kPose.phi()))));
+	std::remove(file.c_str());
+
+	// A missing landmark file is an error, not an empty map.
+	cfg.write("MetricMap_codedLandmarksMap_00_creationOpts", "map_file", file + ".missing");
+	inits.loadFromConfigFile(cfg, "MetricMap");
+	mrpt::maps::CMultiMetricMap mm2;
+	EXPECT_ANY_THROW(mm2.setListOfMaps(inits));
+}
+
+TEST(CodedLandmarksMap, LikelihoodPeaksAtTheTruePose)
+{
+	const CCodedLandmarksMap m(pft::room());
+	const auto o = pft::observe(kPose, m.landmarks());
+	ASSERT_GE(o->sightings.size(), 2u);
+	const double at_truth = loglik(m, *o, kPose);
+	EXPECT_TRUE(std::isfinite(at_truth));
+	for (const auto& d : {CPose2D(0.03, 0, 0), CPose2D(0, -0.03, 0), CPose2D(0, 0, 0.02),
+						  CPose2D(-0.1, 0.05, -0.05), CPose2D(1, 1, 1)})
+		EXPECT_GT(at_truth, loglik(m, *o, kPose + d)) << d;
+}
+
+TEST(CodedLandmarksMap, OutliersStayFiniteAndBounded)
+{
+	CCodedLandmarksMap m(pft::room());
+	auto o = pft::observe(kPose, m.landmarks());
+	const double clean = loglik(m, *o, kPose);
+	auto bad = o->sightings.front();
+	bad.L = {7.5, 0.9, -2.5};  // nothing like the truth
+	o->sightings.push_back(bad);
+	const double with_outlier = loglik(m, *o, kPose);
+	ASSERT_TRUE(std::isfinite(with_outlier));
+	// The mixture's floor: log(p U), U = 1 / (max_range (2 pi)^2).
+	const auto& lo = m.likelihoodOptions;
+	const double floor = std::log(lo.outlier_probability) - std::log(lo.max_range_m * 4 * M_PI * M_PI);
+	EXPECT_GE(with_outlier - clean, floor - 1e-9);
+	EXPECT_LT(with_outlier - clean, floor + 0.1);
+	// Without the uniform, the same outlier costs far more.
+	m.likelihoodOptions.outlier_probability = 0;
+	EXPECT_LT(loglik(m, *o, kPose) - loglik(m, *pft::observe(kPose, m.landmarks()), kPose), floor - 100);
+}
+
+TEST(CodedLandmarksMap, UnknownIdsChangeNothing)
+{
+	const CCodedLandmarksMap m(pft::room());
+	auto o = pft::observe(kPose, m.landmarks());
+	const CPose2D other(3, 2.5, -1);
+	const double a = loglik(m, *o, kPose), b = loglik(m, *o, other);
+	auto s = o->sightings.front();
+	s.id = 200;  // not in the map
+	s.L = {1.0, 0.1, 0.2};
+	o->sightings.push_back(s);
+	EXPECT_EQ(loglik(m, *o, kPose), a);
+	EXPECT_EQ(loglik(m, *o, other), b);
+}
+
+TEST(CodedLandmarksMap, BearingRangeLikelihoodPeaksAtTheTruth)
+{
+	const CCodedLandmarksMap m(pft::room());
+	const auto o = pft::observe(kPose, m.landmarks());
+	const auto br = o->toBearingRange();
+	ASSERT_GE(br->sensedData.size(), 2u);
+	const double at_truth = loglik(m, *br, kPose);
+	ASSERT_TRUE(std::isfinite(at_truth));
+	for (const auto& d : {CPose2D(0.05, 0, 0), CPose2D(0, 0.05, 0), CPose2D(0, 0, 0.03),
+						  CPose2D(0.5, -0.5, 0.4)})
+		EXPECT_GT(at_truth, loglik(m, *br, kPose + d)) << d;
+
+	// Without per-reading covariances: the sensor's standard deviations.
+	auto br2 = mrpt::obs::CObservationBearingRange::Create(*br);
+	br2->validCovariances = false;
+	br2->sensor_std_range = 0.02f;
+	br2->sensor_std_yaw = 0.01f;
+	br2->sensor_std_pitch = 0;
+	const double t2 = loglik(m, *br2, kPose);
+	EXPECT_GT(t2, loglik(m, *br2, kPose + CPose2D(0.05, 0, 0)));
+	EXPECT_GT(t2, loglik(m, *br2, kPose + CPose2D(0, 0, 0.03)));
+}
+
+TEST(CodedLandmarksMap, RepresentationAndVisualization)
+{
+	const CCodedLandmarksMap m(pft::room());
+	const std::string prefix = mrpt::system::getTempFileName();
+	m.saveMetricMapRepresentationToFile(prefix);
+	const auto back = codemark::LandmarkMap::load(prefix + "_landmarks.txt");
+	EXPECT_EQ(back.landmarks.size(), m.landmarks().landmarks.size());
+	std::remove((prefix + "_landmarks.txt").c_str());
+	mrpt::opengl::CSetOfObjects gl;
+	m.getVisualizationInto(gl);
+	EXPECT_GE(gl.size(), m.landmarks().landmarks.size());
+	EXPECT_FALSE(m.isEmpty());
+	EXPECT_TRUE(CCodedLandmarksMap().isEmpty());
+}
+
+// --------------------------------------------------------- particle filter
+namespace
+{
+struct RunResult
+{
+	int frames_with_sightings_to_converge = -1;  //!< -1: never within 10 cm
+	double final_error_m = 1e9;
+	bool initialized = false;
+};
+
+/** Runs the filter along the circle from step \a k0 to \a k1; \a kidnap_at:
+ * the true pose jumps by \a jump there (odometry does not see it). */
+RunResult runCircle(
+	codemark::filters::Localizer& f, int k0, int k1, std::mt19937& rng, int kidnap_at = -1,
+	const CPose2D& jump = CPose2D())
+{
+	RunResult r;
+	const auto map = pft::room();
+	int frames_with_sightings = 0;
+	CPose2D offset;
+	for (int k = k0; k < k1; ++k)
+	{
+		if (k == kidnap_at) offset = jump;
+		const CPose2D truth = offset + pft::circlePose(k);
+		const auto odo = pft::odometry(pft::circlePose(k - 1), pft::circlePose(k), rng);
+		mrpt::obs::CSensoryFrame sf;
+		const auto o = pft::observe(truth, map, &rng, 0.2 * k);
+		if (!o->sightings.empty()) ++frames_with_sightings;
+		sf.insert(o);
+		f.step(k == k0 ? nullptr : &odo, sf);
+		const auto e = f.estimate();
+		r.final_error_m = positionError(e, truth);
+		r.initialized = e.initialized;
+		if (r.frames_with_sightings_to_converge < 0 && k >= std::max(k0, kidnap_at) &&
+			r.final_error_m < 0.10 && e.initialized)
+			r.frames_with_sightings_to_converge = frames_with_sightings;
+	}
+	return r;
+}
+}  // namespace
+
+TEST(ParticleFilter, ConvergesFromAUniformStart)
+{
+	for (int seed : {1, 2, 3})
+	{
+		auto cfg = shippedConfig(seed);
+		const auto f = codemark::filters::makeLocalizer("pf", cfg, pft::room());
+		ASSERT_EQ(f->method(), "pf");
+		EXPECT_FALSE(f->estimate().initialized);
+		std::mt19937 rng(seed);
+		const RunResult r = runCircle(*f, 0, 60, rng);
+		// Issue 6 target: converged (< 10 cm) within 3 sightings.
+		EXPECT_GE(r.frames_with_sightings_to_converge, 1) << "seed " << seed;
+		EXPECT_LE(r.frames_with_sightings_to_converge, 3) << "seed " << seed;
+		EXPECT_LT(r.final_error_m, 0.10) << "seed " << seed;
+		EXPECT_TRUE(r.initialized);
+		const auto e = f->estimate();
+		EXPECT_TRUE(e.cov.isApprox(e.cov.transpose()));
+		EXPECT_GT(e.cov.determinant(), 0);
+	}
+}
+
+TEST(ParticleFilter, RecoversFromAKidnapping)
+{
+	auto cfg = shippedConfig(7);
+	codemark::filters::ParticleFilterLocalizer f(cfg, pft::room());
+	std::mt19937 rng(7);
+	const RunResult before = runCircle(f, 0, 30, rng);
+	ASSERT_LT(before.final_error_m, 0.10);
+	const int injections = f.injections();
+	// Carried 1.5 m away and turned: the odometry knows nothing of it.
+	const RunResult after = runCircle(f, 30, 110, rng, 30, CPose2D(-1.2, 0.9, 0.0));
+	EXPECT_GT(f.injections(), injections);
+	EXPECT_GE(after.frames_with_sightings_to_converge, 1);
+	EXPECT_LT(after.final_error_m, 0.10);
+}
+
+TEST(ParticleFilter, StartsAroundAGivenPose)
+{
+	auto cfg = shippedConfig(5);
+	codemark::filters::PoseEstimate init;
+	init.initialized = true;
+	init.mean = pft::circlePose(0);
+	init.cov = Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal();
+	const auto f = codemark::filters::makeLocalizer("pf", cfg, pft::room(), init);
+	EXPECT_TRUE(f->estimate().initialized);
+	EXPECT_LT(positionError(f->estimate(), pft::circlePose(0)), 0.05);
+	std::mt19937 rng(5);
+	const RunResult r = runCircle(*f, 0, 40, rng);
+	EXPECT_LT(r.final_error_m, 0.10);
+}
+
+TEST(ParticleFilter, CountsUnknownIdsAndRejectsWrongSightings)
+{
+	auto cfg = shippedConfig(9);
+	const auto f = codemark::filters::makeLocalizer("pf", cfg, pft::room());
+	std::mt19937 rng(9);
+	runCircle(*f, 0, 20, rng);
+	ASSERT_TRUE(f->estimate().initialized);
+	const CPose2D truth = pft::circlePose(20);
+	auto o = pft::observe(truth, pft::room(), nullptr, 4.0);
+	ASSERT_FALSE(o->sightings.empty());
+	const size_t good = o->sightings.size();
+	auto unknown = o->sightings.front();
+	unknown.id = 250;
+	auto wrong = o->sightings.front();
+	wrong.L[0] += 1.0;  // a planted sighting 1 m off
+	o->sightings.push_back(unknown);
+	o->sightings.push_back(wrong);
+	mrpt::obs::CSensoryFrame sf;
+	sf.insert(o);
+	const auto odo = pft::odometry(pft::circlePose(19), pft::circlePose(20), rng);
+	const auto st = f->step(&odo, sf);
+	EXPECT_EQ(st.unknown_id, 1);
+	EXPECT_EQ(st.rejected, 1);
+	EXPECT_EQ(st.used, static_cast<int>(good));
+	EXPECT_LT(positionError(f->estimate(), truth), 0.10);
+}
+
+TEST(ParticleFilter, BadConfigurationThrows)
+{
+	auto cfg = shippedConfig(1);
+	cfg.write("ParticleFilter", "particles_count", 0);
+	EXPECT_THROW(codemark::filters::makeLocalizer("pf", cfg, pft::room()), std::invalid_argument);
+	auto cfg2 = shippedConfig(1);
+	EXPECT_THROW(
+		codemark::filters::makeLocalizer("pf", cfg2, codemark::LandmarkMap()), std::invalid_argument);
+	auto cfg3 = shippedConfig(1);
+	cfg3.write("MetricMap_codedLandmarksMap_00_likelihoodOpts", "outlier_probability", 1.5);
+	EXPECT_THROW(codemark::filters::makeLocalizer("pf", cfg3, pft::room()), std::invalid_argument);
+}
