@@ -174,7 +174,7 @@ std::optional<Quad> coarseQuad(const cv::Mat& img)
 	const auto cands = findCandidates(mask, 2, img, ComponentParams());
 	if (cands.size() != 1) return std::nullopt;
 	const auto m = findEdgels(img, cands[0].roi, gradientThreshold(cands[0].fill_g, EdgelParams()), EdgelParams());
-	const auto s = selectSegments(m.domains, cands[0], SegmentParams());
+	const auto s = selectSegments(m.domains, cands[0], mask, 2, SegmentParams());
 	if (!s) return std::nullopt;
 	return linkQuadrangle(*s, QuadParams());
 }

@@ -122,8 +122,24 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 }
 
 std::optional<SideSegments> selectSegments(
-	const std::vector<EdgelDomain>& domains, const Candidate& c, const SegmentParams& p)
+	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
+	const SegmentParams& p)
 {
+	// Is the fill colour found just inside a domain (towards the fill) at
+	// two of three points along it? Rejects edges outside the frame (the
+	// sheet against the wall), which the fill's bounding box may come near
+	// when the codec smears the green over the thin frame.
+	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward) {
+		int hits = 0;
+		const double reach = std::max(2.0, step + 1.0);
+		for (const double t : {-0.25, 0.0, 0.25})
+		{
+			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
+			const int x = static_cast<int>(std::floor(q.x() / step)), y = static_cast<int>(std::floor(q.y() / step));
+			if (x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x)) ++hits;
+		}
+		return hits >= 2;
+	};
 	SideSegments out;
 	const Polarity order[4] = {Polarity::Top, Polarity::Right, Polarity::Bottom, Polarity::Left};
 	for (int k = 0; k < 4; ++k)
@@ -151,6 +167,9 @@ std::optional<SideSegments> selectSegments(
 			// Along the side: a vertical side's direction is mostly vertical.
 			if (std::abs(d.dir(1 - axis)) < std::abs(d.dir(axis))) continue;
 			if (low_side ? d.mean(axis) >= c.centroid(axis) : d.mean(axis) <= c.centroid(axis)) continue;
+			Eigen::Vector2d inward = Eigen::Vector2d::Zero();
+			inward(axis) = low_side ? 1 : -1;
+			if (!mask.empty() && !fillInside(d, inward)) continue;
 			const double dist = std::abs(d.mean(axis) - bbox_side);
 			if (dist < best_dist)
 			{

@@ -98,10 +98,12 @@ EdgelMap findEdgels(
 using SideSegments = std::array<EdgelDomain, 4>;
 
 /** Picks, for each side, the domain of that polarity on that side of the
- * fill's centroid, long and slim enough, nearest the fill's bounding box
- * side. */
+ * fill's centroid, long and slim enough, with the fill colour just inside
+ * it in \a mask (grid step \a step; an empty mask skips that test),
+ * nearest the fill's bounding box side. */
 std::optional<SideSegments> selectSegments(
-	const std::vector<EdgelDomain>& domains, const Candidate& c, const SegmentParams& p);
+	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
+	const SegmentParams& p);
 
 // ------------------------------------------------------------------ stage 6
 /** Coarse corners TL, TR, BR, BL [raw px]. */
