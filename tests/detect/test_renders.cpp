@@ -1,0 +1,309 @@
+// The detector on renders of codemark::sim with exact ground truth: every
+// landmark found with the right ID and corners within 0.3 px over the
+// ranges of issue 3, exhaustive decoding, flipped cells, negatives.
+#include "common.h"
+
+#include <codemark/landmark/codebook.h>
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+using namespace codemark;
+using namespace codemark::detect;
+using namespace codemark::detect::test;
+
+namespace
+{
+constexpr double kCornerTolPx = 0.3;
+// Known limits (see the report of issue 3): where the green fill saturates
+// the sensor (gain > 1: G clipped at 255 between 1x and ~1.7x its printed
+// level) the edge's bright side is cut and the edges move outwards by up to
+// ~0.4 px; at 5 m and 60 deg the black frame is 1.6 px wide across the
+// vertical sides and its outer edge pulls the inner one.
+constexpr double kSaturatedTolPx = 0.6;
+constexpr double kFarObliqueTolPx = 0.5;
+
+/** Renders one landmark and checks it is found, with its ID and corners. */
+void expectFound(const std::string& what, int id, double dist, double angle_rad, const sim::RenderOptions& o,
+	uint64_t seed, double bearing = 0, double height = 0, double tol = kCornerTolPx)
+{
+	const Shot s = shoot(id, dist, angle_rad, o, seed, bearing, height);
+	const auto& t = s.render.truth[0];
+	ASSERT_TRUE(t.fully_visible) << what;
+	const auto r = run(s.render.image);
+	ASSERT_EQ(r.landmarks.size(), 1u) << what;
+	const auto& d = r.landmarks[0].detection;
+	EXPECT_EQ(d.id, id) << what;
+	EXPECT_LT(maxCornerError(d, t), tol) << what;
+	// P from the detected corners close to the exact one.
+	EXPECT_LT((r.landmarks[0].P - t.P).cwiseAbs().maxCoeff(), tol) << what;
+}
+
+std::string label(const char* name, double v, uint64_t seed)
+{
+	std::ostringstream s;
+	s << name << "=" << v << " seed=" << seed;
+	return s.str();
+}
+}  // namespace
+
+// ------------------------------------------------------------------ ranges
+
+TEST(Renders, Distance0p5To5m)
+{
+	int n = 0;
+	for (double d = 0.5; d <= 5.001; d += 0.25)
+		for (int k = 0; k < 3; ++k, ++n)
+			// Off-centre by up to a quarter of the field of view where it fits.
+			expectFound(label("distance", d, n), (n * 37) % 256, d, 0, nominalRender(), n,
+				d < 1 ? 0 : (k - 1) * 0.1 * std::min(1.0, d / 2), d < 1 ? 0 : 0.05 * (k - 1));
+	EXPECT_GE(n, 57);
+}
+
+TEST(Renders, ViewAngle0To60Deg)
+{
+	int n = 0;
+	for (double a = 0; a <= 60.001; a += 5)
+		for (int sign : {-1, 1})
+		{
+			const double d = n % 2 ? 1.0 : 2.5;
+			expectFound(label("angle_deg", sign * a, n), (n * 53 + 1) % 256, d, sign * a * kDeg, nominalRender(), 100 + n);
+			++n;
+		}
+	EXPECT_GE(n, 26);
+}
+
+TEST(Renders, IlluminationGainWithGradient)
+{
+	int n = 0;
+	for (double gain : {0.3, 0.45, 0.7, 1.0, 1.4, 2.0})
+		for (double gradient : {0.0, 0.5})
+			for (double angle : {0.0, 40.0})
+			{
+				auto o = nominalRender();
+				o.gain = gain;
+				o.gradient = gradient;
+				o.gradient_angle_rad = n * 0.7;
+				expectFound(label("gain", gain, n), (n * 71 + 5) % 256, 2.0, angle * kDeg, o, 200 + n, 0.1, 0,
+					gain > 1 ? kSaturatedTolPx : kCornerTolPx);
+				++n;
+			}
+	EXPECT_EQ(n, 24);
+}
+
+TEST(Renders, NoiseUpTo5)
+{
+	int n = 0;
+	for (double sigma : {0.0, 1.0, 2.0, 3.0, 4.0, 5.0})
+		for (int k = 0; k < 3; ++k, ++n)
+		{
+			auto o = nominalRender();
+			o.noise_sigma = sigma;
+			expectFound(label("noise", sigma, n), (n * 29 + 7) % 256, 1.0 + k, 20.0 * k * kDeg, o, 300 + n);
+		}
+}
+
+TEST(Renders, BlurUpTo1p5)
+{
+	int n = 0;
+	for (double blur : {0.0, 0.5, 1.0, 1.5})
+		for (int k = 0; k < 3; ++k, ++n)
+		{
+			auto o = nominalRender();
+			o.blur_sigma_px = blur;
+			expectFound(label("blur", blur, n), (n * 41 + 3) % 256, 1.0 + 0.5 * k, 25.0 * k * kDeg, o, 400 + n);
+		}
+}
+
+TEST(Renders, JpegDownTo70)
+{
+	int n = 0;
+	for (int q : {95, 90, 80, 70})
+		for (int k = 0; k < 3; ++k, ++n)
+		{
+			auto o = nominalRender();
+			o.jpeg_quality = q;
+			expectFound(label("jpeg", q, n), (n * 13 + 11) % 256, 1.0 + 0.75 * k, 20.0 * k * kDeg, o, 500 + n);
+		}
+}
+
+TEST(Renders, Combination5mAt60Deg)
+{
+	for (int k = 0; k < 6; ++k)
+		expectFound(label("5m60deg", k, k), (k * 97 + 2) % 256, 5.0, (k % 2 ? 60 : -60) * kDeg, nominalRender(), 600 + k,
+			0.05 * (k - 3), 0, kFarObliqueTolPx);
+}
+
+TEST(Renders, Combination2mBlur1p5Gain0p3)
+{
+	for (int k = 0; k < 6; ++k)
+	{
+		auto o = nominalRender();
+		o.blur_sigma_px = 1.5;
+		o.gain = 0.3;
+		o.gradient = 0.3;
+		expectFound(label("2m blur1.5 gain0.3", k, k), (k * 89 + 4) % 256, 2.0, (k * 10) * kDeg, o, 700 + k);
+	}
+}
+
+// ---------------------------------------------------------- scene content
+
+TEST(Renders, SeveralLandmarksAreAllFound)
+{
+	for (int k = 0; k < 5; ++k)
+	{
+		sim::Scene sc;
+		// Four landmarks on a wall at x = 0 facing +x, the camera 2-3 m away.
+		for (int i = 0; i < 4; ++i)
+		{
+			MapLandmark lm;
+			lm.id = (k * 50 + i * 61) % 256;
+			lm.y_m = -0.6 + 0.4 * i;
+			lm.z_m = (i % 2) * 0.3 - 0.15;
+			sc.map.landmarks.push_back(lm);
+		}
+		MapLandmark centre;
+		sc.world_T_camera = sim::levelCameraLookingAt(centre, 2.0 + 0.25 * k, (k - 2) * 10 * kDeg);
+		auto o = nominalRender();
+		o.background = sim::Background::Cluttered;
+		o.distractors = 4;
+		const auto r = sim::render(sc, o, 800 + k);
+		const auto res = run(r.image);
+		int visible = 0;
+		for (const auto& t : r.truth)
+		{
+			if (!t.fully_visible) continue;
+			++visible;
+			const auto it = std::find_if(res.landmarks.begin(), res.landmarks.end(),
+				[&](const DetectedLandmark& d) { return d.detection.id == t.id; });
+			ASSERT_NE(it, res.landmarks.end()) << "scene " << k << " id " << t.id;
+			EXPECT_LT(maxCornerError(it->detection, t), kCornerTolPx) << "scene " << k << " id " << t.id;
+		}
+		EXPECT_GE(visible, 3);
+		EXPECT_EQ(static_cast<int>(res.landmarks.size()), visible) << "scene " << k;
+	}
+}
+
+TEST(Renders, LandmarkPartlyOutsideIsNotReported)
+{
+	// Bearing such that the landmark straddles the left or right border.
+	for (int k = 0; k < 6; ++k)
+	{
+		const double d = 1.0 + 0.5 * (k / 2);
+		const double half_fov = std::atan(320.0 / 800);
+		const double bearing = (k % 2 ? 1 : -1) * (half_fov + 0.03 / d);
+		const Shot s = shoot(9, d, 0, nominalRender(), 900 + k, bearing);
+		ASSERT_FALSE(s.render.truth[0].fully_visible);
+		EXPECT_TRUE(run(s.render.image).landmarks.empty()) << "k " << k;
+	}
+}
+
+// ------------------------------------------------------------------- codes
+
+TEST(Renders, AllIdsDecode)
+{
+	for (int id = 0; id < kNumIds; ++id)
+	{
+		auto o = nominalRender();
+		o.background = sim::Background::Flat;
+		const Shot s = shoot(id, 1.5 + (id % 4) * 0.5, ((id % 7) - 3) * 10 * kDeg, o, 1000 + id);
+		const auto r = run(s.render.image);
+		ASSERT_EQ(r.landmarks.size(), 1u) << "id " << id;
+		EXPECT_EQ(r.landmarks[0].detection.id, id);
+	}
+}
+
+TEST(Renders, FlippedCellGivesAnotherIdOrNothing)
+{
+	int other = 0, rejected = 0;
+	for (int id : {0, 37, 170, 255})
+		for (int row = 0; row < 3; ++row)
+			for (int col = 0; col < 3; ++col)
+			{
+				if (row == 1 && col == 1) continue;
+				Shot s = shoot(id, 1.5, 15 * kDeg, nominalRender(), 1300 + id);
+				const bool black = encodeId(id)[row][col];
+				paintCell(s.render.image, s.render.truth[0], row, col, !black);
+				const auto r = run(s.render.image);
+				ASSERT_LE(r.landmarks.size(), 1u);
+				if (r.landmarks.empty())
+				{
+					++rejected;
+					continue;
+				}
+				CodeCells cells = encodeId(id);
+				cells[row][col] = !black;
+				EXPECT_EQ(r.landmarks[0].detection.id, *decodeCells(cells));
+				++other;
+			}
+	EXPECT_EQ(other + rejected, 32);
+	EXPECT_GT(other, 0);
+}
+
+// --------------------------------------------------------------- negatives
+
+TEST(Renders, GreenCentreCellIsNotALandmark)
+{
+	for (int id : {0, 99, 255})
+	{
+		Shot s = shoot(id, 1.5, 20 * kDeg, nominalRender(), 1400 + id);
+		paintCell(s.render.image, s.render.truth[0], 1, 1, false);
+		EXPECT_TRUE(run(s.render.image).landmarks.empty()) << id;
+	}
+}
+
+TEST(Renders, FrameFilledWithAnotherColourIsNotALandmark)
+{
+	const LandmarkGeometry g;
+	const double h = g.innerHalf();
+	for (const cv::Scalar& fill : {cv::Scalar(30, 30, 200), cv::Scalar(200, 40, 30), cv::Scalar(0, 200, 200),
+			 cv::Scalar(235, 235, 235), cv::Scalar(40, 120, 160)})
+	{
+		Shot s = shoot(77, 1.5, 10 * kDeg, nominalRender(), 1500);
+		paintFace(s.render.image, s.render.truth[0], g,
+			{Eigen::Vector2d(-h, h), Eigen::Vector2d(h, h), Eigen::Vector2d(h, -h), Eigen::Vector2d(-h, -h)}, fill);
+		paintCell(s.render.image, s.render.truth[0], 1, 1, true);
+		EXPECT_TRUE(run(s.render.image).landmarks.empty()) << fill;
+	}
+}
+
+TEST(Renders, ClutterWithoutLandmarksGivesNothing)
+{
+	// A landmark behind the camera: only the cluttered wall (green shapes,
+	// black frames filled with other colours, posters, marker-like squares).
+	int found = 0;
+	for (int k = 0; k < 40; ++k)
+	{
+		sim::Scene sc;
+		MapLandmark lm;
+		lm.id = 1;
+		sc.map.landmarks.push_back(lm);
+		sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
+		auto o = nominalRender();
+		o.background = sim::Background::Cluttered;
+		o.distractors = 12;
+		const auto r = sim::render(sc, o, 2000 + k);
+		found += static_cast<int>(run(r.image).landmarks.size());
+	}
+	EXPECT_EQ(found, 0);
+}
+
+TEST(Renders, GreyOnlyImageGivesNothing)
+{
+	auto o = nominalRender();
+	o.background = sim::Background::Textured;
+	sim::Scene sc;
+	MapLandmark lm;
+	sc.map.landmarks.push_back(lm);
+	sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
+	cv::Mat grey;
+	cv::cvtColor(sim::render(sc, o, 3000).image, grey, cv::COLOR_BGR2GRAY);
+	cv::cvtColor(grey, grey, cv::COLOR_GRAY2BGR);
+	EXPECT_TRUE(run(grey).landmarks.empty());
+	// A landmark rendered, then made grey: no colour, no detection.
+	const Shot s = shoot(5, 1.5, 0, nominalRender(), 3001);
+	cv::cvtColor(s.render.image, grey, cv::COLOR_BGR2GRAY);
+	cv::cvtColor(grey, grey, cv::COLOR_GRAY2BGR);
+	EXPECT_TRUE(run(grey).landmarks.empty());
+}
