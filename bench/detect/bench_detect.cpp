@@ -348,18 +348,6 @@ struct StageLog
 		return s.str();
 	}
 };
-		const double t = mean(total);
-		std::vector<std::pair<double, std::string>> st{{mean(seg), "segmentation"}, {mean(comp), "components"},
-			{mean(edg), "edgels"}, {mean(segm), "segments"}, {mean(quad), "quads"}, {mean(sub), "subpixel"},
-			{mean(code), "code"}};
-		std::sort(st.rbegin(), st.rend());
-		std::ostringstream s;
-		s << "mean total " << fmt(t / 1e3, 3) << " ms: ";
-		for (size_t i = 0; i < st.size(); ++i)
-			s << (i ? ", " : "") << st[i].second << " " << fmt(t > 0 ? 100 * st[i].first / t : 0, 0) << "%";
-		return s.str();
-	}
-};
 
 std::string machine()
 {
