@@ -133,7 +133,10 @@ TEST(Components, ARingIsCompactEnoughAndALShapeIsNot)
 TEST(Edgels, PolarityOfTheInnerEdges)
 {
 	const cv::Mat img = craftedLandmark(0);
-	const auto m = findEdgels(img, cv::Rect(20, 20, 140, 140), 10, EdgelParams());
+	EdgelParams full;
+	full.max_roi_px = 1000;  // no reduction
+	const auto m = findEdgels(img, cv::Rect(20, 20, 140, 140), 10, full);
+	ASSERT_EQ(m.scale, 1);
 	// Inner left edge between pixels 49 and 50: G rises to the right.
 	EXPECT_EQ(m.polarity.at<uint8_t>(90 - 20, 49 - 20) | m.polarity.at<uint8_t>(90 - 20, 50 - 20),
 		static_cast<uint8_t>(Polarity::Left));
@@ -155,6 +158,19 @@ TEST(Edgels, PolarityOfTheInnerEdges)
 			if (d.polarity == pol && d.width_px < 1) longest = std::max(longest, d.length_px);
 		EXPECT_GT(longest, 60) << static_cast<int>(pol);
 	}
+	// A large ROI is reduced (here by 2) but domains stay in image pixels:
+	// the left inner edge lies at u = 49.5.
+	const auto r = findEdgels(img, cv::Rect(20, 20, 140, 140), 10, EdgelParams());
+	ASSERT_EQ(r.scale, 2);
+	bool left_found = false;
+	for (const auto& d : r.domains)
+		if (d.polarity == Polarity::Left && d.length_px > 60 && d.mean.x() < 90)  // not the outer right edge
+		{
+			EXPECT_NEAR(d.mean.x(), 49.5, 1.0);
+			EXPECT_NEAR(d.mean.y(), 89.5, 3.0);
+			left_found = true;
+		}
+	EXPECT_TRUE(left_found);
 }
 
 TEST(Edgels, FlatImageHasNone)

@@ -97,7 +97,8 @@ void writeDebugImages(
 			for (int x = 0; x < e.polarity.cols; ++x)
 			{
 				const uint8_t p = e.polarity.at<uint8_t>(y, x);
-				if (p) ed.at<cv::Vec3b>(y + e.roi.y, x + e.roi.x) = colours[p];
+				if (p)
+					ed(cv::Rect(e.roi.x + x * e.scale, e.roi.y + y * e.scale, e.scale, e.scale)).setTo(colours[p]);
 			}
 		cv::rectangle(ed, e.roi, {255, 255, 255});
 	}

@@ -20,15 +20,23 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 	EdgelMap m;
 	m.roi = roi_in & cv::Rect(0, 0, bgr.cols, bgr.rows);
 	m.threshold = threshold;
-	if (m.roi.width < 3 || m.roi.height < 3) return m;
+	// Large ROIs (near landmarks) are reduced by an integer factor: this
+	// stage only finds the sides to about a pixel, the sub-pixel stage works
+	// at full resolution, and the cost stays bounded.
+	const int k = std::max(1, static_cast<int>(std::ceil(std::max(m.roi.width, m.roi.height) / p.max_roi_px)));
+	m.scale = k;
+	m.roi.width -= m.roi.width % k;
+	m.roi.height -= m.roi.height % k;
+	if (m.roi.width < 3 * k || m.roi.height < 3 * k) return m;
 	cv::Mat g, gx, gy;
 	cv::extractChannel(bgr(m.roi), g, 1);
+	if (k > 1) cv::resize(g, g, cv::Size(m.roi.width / k, m.roi.height / k), 0, 0, cv::INTER_AREA);
 	cv::Sobel(g, gx, CV_16S, 1, 0, 3, 1, 0, cv::BORDER_REPLICATE);
 	cv::Sobel(g, gy, CV_16S, 0, 1, 3, 1, 0, cv::BORDER_REPLICATE);
 	// The 3x3 Sobel answers 8 per grey level per pixel of slope.
 	const int t = static_cast<int>(std::ceil(8 * threshold));
 	const int t2 = t * t;
-	const int W = m.roi.width, H = m.roi.height;
+	const int W = g.cols, H = g.rows;
 	m.polarity = cv::Mat::zeros(H, W, CV_8UC1);
 	for (int y = 1; y < H - 1; ++y)
 	{
@@ -110,11 +118,14 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 				tmin = std::min(tmin, tt);
 				tmax = std::max(tmax, tt);
 			}
-			const Eigen::Vector2d off(m.roi.x, m.roi.y);
-			d.mean = mean + off;
-			d.end0 = d.mean + tmin * d.dir;
-			d.end1 = d.mean + tmax * d.dir;
-			d.length_px = tmax - tmin + 1;
+			// Back to full-image pixels: reduced pixel x covers full pixels
+			// k x .. k x + k - 1.
+			const Eigen::Vector2d off(m.roi.x + 0.5 * (k - 1), m.roi.y + 0.5 * (k - 1));
+			d.mean = k * mean + off;
+			d.end0 = d.mean + k * tmin * d.dir;
+			d.end1 = d.mean + k * tmax * d.dir;
+			d.length_px = k * (tmax - tmin + 1);
+			d.width_px *= k;
 			m.domains.push_back(d);
 		}
 	}

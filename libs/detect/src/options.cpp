@@ -55,6 +55,7 @@ void forEachField(Options& o, F&& f)
 	f("edgels.min_gradient", o.edgels.min_gradient);
 	f("edgels.rel_gradient", o.edgels.rel_gradient);
 	f("edgels.min_edgels", o.edgels.min_edgels);
+	f("edgels.max_roi_px", o.edgels.max_roi_px);
 	f("segments.min_rel_length", o.segments.min_rel_length);
 	f("segments.max_width_px", o.segments.max_width_px);
 	f("quads.max_gap_px", o.quads.max_gap_px);
@@ -97,6 +98,7 @@ void DetectorOptions::validate() const
 	require(c.max_candidates >= 1, "components.max_candidates", ">= 1");
 	require(edgels.min_gradient > 0 && edgels.rel_gradient >= 0, "edgels.min_gradient/rel_gradient", "> 0 / >= 0");
 	require(edgels.min_edgels >= 2, "edgels.min_edgels", ">= 2");
+	require(edgels.max_roi_px >= 16, "edgels.max_roi_px", ">= 16");
 	require(segments.min_rel_length > 0 && segments.min_rel_length <= 1, "segments.min_rel_length", "in (0, 1]");
 	require(segments.max_width_px > 0, "segments.max_width_px", "> 0");
 	require(quads.max_gap_px >= 0 && quads.max_gap_rel >= 0, "quads.max_gap_*", ">= 0");

@@ -80,7 +80,8 @@ struct EdgelDomain
 struct EdgelMap
 {
 	cv::Rect roi;  //!< in full-image pixels
-	cv::Mat polarity;  //!< CV_8UC1 of roi size, Polarity values
+	int scale = 1;  //!< reduction factor of the gradient image (large ROIs)
+	cv::Mat polarity;  //!< CV_8UC1 of roi size / scale, Polarity values
 	std::vector<EdgelDomain> domains;  //!< with at least min_edgels edgels
 	double threshold = 0;  //!< gradient threshold used [grey levels / px]
 };
@@ -88,8 +89,10 @@ struct EdgelMap
 /** Gradient threshold for a candidate whose fill has mean G \a fill_g. */
 double gradientThreshold(double fill_g, const EdgelParams& p);
 
-/** Gradients of G (3x3 Sobel) in \a roi at full resolution, non-maximum
- * suppressed edgels with polarity, grouped into domains. */
+/** Gradients of G (3x3 Sobel) in \a roi, non-maximum suppressed edgels
+ * with polarity, grouped into domains. At full resolution unless the ROI is
+ * larger than max_roi_px, then reduced by an integer factor (domains are
+ * still given in full-image pixels). */
 EdgelMap findEdgels(
 	const cv::Mat& bgr, const cv::Rect& roi, double threshold, const EdgelParams& p);
 

@@ -65,7 +65,7 @@ struct ComponentParams
 };
 
 /** Stage 4: gradients of the G channel inside the ROI (3x3 Sobel, full
- * resolution), edgels (non-maximum suppressed along the dominant gradient
+ * resolution up to max_roi_px), edgels (non-maximum suppressed along the dominant gradient
  * axis) with their polarity, grouped into 8-connected edgel domains of one
  * polarity. */
 struct EdgelParams
@@ -78,6 +78,11 @@ struct EdgelParams
 	double rel_gradient = 0.06;
 	/** Domains with fewer edgels are dropped. */
 	int min_edgels = 5;
+	/** ROIs larger than this [px] are reduced by the smallest integer factor
+	 * that brings them under it before the gradients (near landmarks: this
+	 * stage needs the sides to a pixel, the sub-pixel stage works at full
+	 * resolution). */
+	double max_roi_px = 128;
 };
 
 /** Stage 5: selection of the four inner frame edges among the domains. */
