@@ -195,6 +195,7 @@ struct Stats
 	long wrong_id = 0;  // a detection on a print with another ID
 	long false_pos = 0;  // a detection where no print is
 	double err_sum = 0, err_max = 0;  // corner errors [px]
+	double radial_sum = 0;  // signed error along centre -> corner (outward positive) [px]
 	long err_n = 0;
 	std::vector<double> times_us;  // thread CPU time per frame
 	std::vector<double> wall_us;  // wall time per frame
@@ -206,6 +207,7 @@ struct Stats
 		wrong_id += o.wrong_id;
 		false_pos += o.false_pos;
 		err_sum += o.err_sum;
+		radial_sum += o.radial_sum;
 		err_max = std::max(err_max, o.err_max);
 		err_n += o.err_n;
 		times_us.insert(times_us.end(), o.times_us.begin(), o.times_us.end());
@@ -213,6 +215,7 @@ struct Stats
 	}
 	double rate() const { return truths ? double(detected) / truths : std::nan(""); }
 	double meanErr() const { return err_n ? err_sum / err_n : std::nan(""); }
+	double meanRadial() const { return err_n ? radial_sum / err_n : std::nan(""); }
 };
 
 /** Scores \a dets against \a truth into \a s: a detection whose centre lies
@@ -248,10 +251,15 @@ void score(const std::vector<Det>& dets, const std::vector<cb::PrintTruth>& trut
 		if (found[hit] || !t.sheet_visible) continue;  // a duplicate, or a print partly outside
 		found[hit] = true;
 		++s.detected;
+		Eigen::Vector2d tcen = Eigen::Vector2d::Zero();
+		for (const auto& tc : t.corners_px) tcen += 0.25 * tc;
 		for (const auto& tc : t.corners_px)
 		{
 			double best = 1e300;
-			for (const auto& p : d.c) best = std::min(best, (p - tc).norm());
+			Eigen::Vector2d bp = tc;
+			for (const auto& p : d.c)
+				if ((p - tc).norm() < best) best = (p - tc).norm(), bp = p;
+			s.radial_sum += (bp - tc).dot((tc - tcen).normalized());
 			s.err_sum += best;
 			s.err_max = std::max(s.err_max, best);
 			++s.err_n;
@@ -763,9 +771,9 @@ int runBench(const Config& cfg)
 		  "[px], per distance, all angles (target: codemark mean <= 0.1 px and no worse than AprilTag d1 at each "
 		  "distance):\n\n| distance | ref. square [px] |";
 	for (const auto& d : dets) md << " " << d.name << " mean | max |";
-	md << " codemark <= AprilTag d1 |\n|---|---|";
+	md << " codemark <= AprilTag d1 | codemark outward bias | AprilTag d1 outward bias |\n|---|---|";
 	for (size_t k = 0; k < ND; ++k) md << "---|---|";
-	md << "---|\n";
+	md << "---|---|---|\n";
 	for (size_t di = 0; di < distances.size(); ++di)
 	{
 		md << "| " << fmt(distances[di], 2) << " m | " << fmt(800 * ref_m / distances[di], 0) << " |";
@@ -776,11 +784,15 @@ int runBench(const Config& cfg)
 			md << " " << fmt(row[k].meanErr(), 3) << " | " << fmt(row[k].err_n ? row[k].err_max : NAN, 3) << " |";
 		}
 		const bool ok = row[0].err_n && row[2].err_n ? row[0].meanErr() <= row[2].meanErr() : false;
-		md << " " << (ok ? "yes" : "**no**") << " |\n";
+		md << " " << (ok ? "yes" : "**no**") << " | " << fmt(row[0].meanRadial(), 3) << " | "
+		   << fmt(row[2].meanRadial(), 3) << " |\n";
 	}
 	md << "| all | |";
 	for (size_t k = 0; k < ND; ++k) md << " " << fmt(all[k].meanErr(), 3) << " | " << fmt(all[k].err_max, 3) << " |";
-	md << " |\n\n";
+	md << " | " << fmt(all[0].meanRadial(), 3) << " | " << fmt(all[2].meanRadial(), 3) << " |\n\n"
+	   << "Outward bias: mean signed corner error along the line from the square's centre through the true corner "
+		  "(positive: the detected square is too large) [px]; a bias near the mean error means a systematic "
+		  "offset, a small one means noise.\n\n";
 
 	md << "## False detections\n\n| detector | background-only frames | false detections | frames with any | "
 		  "sweep: wrong IDs | sweep: false positives |\n|---|---|---|---|---|---|\n";
