@@ -75,6 +75,18 @@ void EkfSlamOptions::loadFromConfigFile(
 				"ekf-slam: [" + s + "] input = '" + in +
 				"' (expected auto, coded, bearing_range or both)");
 	}
+	const std::string lm = c.read_string(s, "landmarks", "", false);
+	if (!lm.empty())
+	{
+		if (lm == "auto") landmarks = SlamLandmarks::Auto;
+		else if (lm == "full")
+			landmarks = SlamLandmarks::Full;
+		else if (lm == "point")
+			landmarks = SlamLandmarks::Point;
+		else
+			throw std::invalid_argument(
+				"ekf-slam: [" + s + "] landmarks = '" + lm + "' (expected auto, full or point)");
+	}
 	MRPT_LOAD_CONFIG_VAR(gate_probability, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(std_sensor_range, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(std_sensor_yaw_deg, double, c, s);
@@ -96,6 +108,8 @@ void EkfSlamOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 {
 	static const char* kInput[] = {"auto", "coded", "bearing_range", "both"};
 	c.write(s, "input", std::string(kInput[static_cast<int>(input)]), -1, -1);
+	static const char* kLandmarks[] = {"auto", "full", "point"};
+	c.write(s, "landmarks", std::string(kLandmarks[static_cast<int>(landmarks)]), -1, -1);
 	c.write(s, "gate_probability", gate_probability, -1, -1);
 	c.write(s, "std_sensor_range", std_sensor_range, -1, -1);
 	c.write(s, "std_sensor_yaw_deg", std_sensor_yaw_deg, -1, -1);
@@ -182,7 +196,9 @@ struct Sighting
 	int id = -1;
 	Eigen::Vector3d z = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] or [range yaw 0]
 	Eigen::Matrix3d C = Eigen::Matrix3d::Identity();  //!< covariance of z (dummy 1 on the third for points)
-	Eigen::Matrix3d W = Eigen::Matrix3d::Identity();  //!< whitening: W C W^T = I
+	/** Whitening W = chol(C)^-1 (lower triangular, so its top-left 2x2
+	 * block whitens the range-bearing part alone). */
+	Eigen::Matrix3d W = Eigen::Matrix3d::Identity();
 	mrpt::poses::CPose2D sensor;  //!< sensor's planar pose on the robot
 	bool point = false;  //!< range-bearing: the third component is unused
 	double height_m = std::numeric_limits<double>::quiet_NaN();  //!< landmark z estimate
@@ -199,9 +215,35 @@ struct LandmarkInfo
 	bool z_prior = false;  //!< z_sum holds the prior's z
 };
 
-class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
+/** The filter, D = 3: landmarks (x, y, yaw), measurements [l2 phi1 phi2]
+ * (CKalmanFilterCapable<3,3,3,3>); D = 2: point landmarks (x, y),
+ * measurements [range yaw] (CKalmanFilterCapable<3,2,2,3>, as
+ * CRangeBearingKFSLAM2D), for range-bearing-only data. */
+template <std::size_t D>
+class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 {
+	using Base = mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>;
+	using typename Base::KFArray_ACT;
+	using typename Base::KFArray_FEAT;
+	using typename Base::KFArray_OBS;
+	using typename Base::KFArray_VEH;
+	using typename Base::KFMatrix;
+	using typename Base::KFMatrix_FxF;
+	using typename Base::KFMatrix_FxO;
+	using typename Base::KFMatrix_FxV;
+	using typename Base::KFMatrix_OxF;
+	using typename Base::KFMatrix_OxO;
+	using typename Base::KFMatrix_OxV;
+	using typename Base::KFMatrix_VxV;
+	using typename Base::vector_KFArray_OBS;
+	using VecD = Eigen::Matrix<double, D, 1>;
+	using MatD = Eigen::Matrix<double, D, D>;
+	using MatDx3 = Eigen::Matrix<double, D, 3>;
+
    public:
+	using Base::m_pkk;
+	using Base::m_xkk;
+
 	EkfSlamOptions opts;
 	std::map<int, std::size_t> id_to_idx;
 	std::vector<LandmarkInfo> info;
@@ -222,44 +264,88 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 		m_xkk.assign(3, 0.0);
 		m_pkk.setSize(3, 3);
 		m_pkk.setZero();
-		KF_options.method = mrpt::bayes::kfEKFAlaDavison;
+		this->KF_options.method = mrpt::bayes::kfEKFAlaDavison;
 	}
-
-	using mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>::m_xkk;
-	using mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>::m_pkk;
 
 	void iterate()
 	{
-		sighting_of.assign(getNumberOfLandmarksInTheMap(), -1);
+		sighting_of.assign(this->getNumberOfLandmarksInTheMap(), -1);
 		for (std::size_t i = 0; i < pass.size(); ++i)
 			if (const auto it = id_to_idx.find(pass[i].id); it != id_to_idx.end())
 				sighting_of[it->second] = static_cast<int>(i);
 		new_queue.clear();
 		new_cursor = 0;
-		runOneKalmanIteration();
+		this->runOneKalmanIteration();
 		++iterations;
 	}
 
 	Eigen::Vector3d robot() const { return Eigen::Vector3d(m_xkk[0], m_xkk[1], m_xkk[2]); }
+	/** Landmark \a idx as (x, y, yaw); yaw 0 for D = 2. */
 	Eigen::Vector3d landmark(std::size_t idx) const
 	{
-		const std::size_t o = 3 + 3 * idx;
-		return Eigen::Vector3d(m_xkk[o], m_xkk[o + 1], m_xkk[o + 2]);
+		const std::size_t o = 3 + D * idx;
+		return Eigen::Vector3d(m_xkk[o], m_xkk[o + 1], D == 3 ? m_xkk[o + D - 1] : 0.0);
+	}
+	/** Its covariance as 3x3 (D = 2: the yaw entry is point_yaw_sigma^2). */
+	Eigen::Matrix3d landmarkCov(std::size_t idx) const
+	{
+		const Eigen::Index o = 3 + D * static_cast<Eigen::Index>(idx);
+		Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+		c.topLeftCorner<D, D>() = m_pkk.asEigen().template block<D, D>(o, o);
+		if (D == 2) c(2, 2) = std::pow(opts.point_yaw_sigma_deg * kDeg, 2);
+		return c;
 	}
 
-	// h and its Jacobians for one sighting, the unused third row zeroed for
-	// range-bearing readings (so its zero innovation carries no information).
-	Eigen::Vector3d predict(
-		const Sighting& s, std::size_t idx, Eigen::Matrix3d* Hx, Eigen::Matrix3d* Hy) const
+	// h and its Jacobians for one sighting; for a range-bearing sighting in
+	// the D = 3 filter the unused third row is zeroed (so its zero innovation
+	// carries no information).
+	VecD predict(const Sighting& s, std::size_t idx, MatDx3* Hx, MatD* Hy) const
 	{
-		Eigen::Vector3d h = slamObservation(robot(), s.sensor, landmark(idx), Hx, Hy);
-		if (s.point)
+		Eigen::Matrix3d hx, hy;
+		Eigen::Vector3d h = slamObservation(robot(), s.sensor, landmark(idx), &hx, &hy);
+		if (D == 3 && s.point)
 		{
 			h[2] = 0;
-			if (Hx) Hx->row(2).setZero();
-			if (Hy) Hy->row(2).setZero();
+			hx.row(2).setZero();
+			hy.row(2).setZero();
 		}
-		return h;
+		if (Hx) *Hx = hx.topRows<D>();
+		if (Hy) *Hy = hy.topLeftCorner<D, D>();
+		return h.head<D>();
+	}
+
+	MatD whitening(const Sighting& s) const { return s.W.topLeftCorner<D, D>(); }
+
+	// Wraps the yaws, symmetrises P and checks its diagonal.
+	void normalize()
+	{
+		m_xkk[2] = wrapToPi(m_xkk[2]);
+		if (D == 3)
+			for (std::size_t i = 5; i < static_cast<std::size_t>(m_xkk.size()); i += 3)
+				m_xkk[i] = wrapToPi(m_xkk[i]);
+		auto P = m_pkk.asEigen();
+		const Eigen::Index n = P.rows();
+		for (Eigen::Index r = 0; r < n; ++r)
+		{
+			for (Eigen::Index c = r + 1; c < n; ++c)
+			{
+				const double m = 0.5 * (P(r, c) + P(c, r));
+				P(r, c) = m;
+				P(c, r) = m;
+			}
+			if (!std::isfinite(P(r, r)) || P(r, r) < -opts.pd_tolerance)
+				throw std::runtime_error(
+					"ekf-slam: covariance lost positive definiteness (diagonal " +
+					std::to_string(r) + " = " + std::to_string(P(r, r)) + ")");
+			if (P(r, r) < 0) P(r, r) = 0;
+		}
+	}
+
+	void addHeight(std::size_t idx, const Sighting& s)
+	{
+		if (idx >= info.size() || info[idx].z_prior || !std::isfinite(s.height_m)) return;
+		info[idx].z_sum += s.height_m;
+		++info[idx].z_count;
 	}
 
    protected:
@@ -325,7 +411,7 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 				continue;
 			}
 			const Sighting& s = pass[sighting_of[idx]];
-			out[k].asEigen() = s.W * predict(s, idx, nullptr, nullptr);
+			out[k].asEigen() = whitening(s) * predict(s, idx, nullptr, nullptr);
 		}
 	}
 
@@ -338,10 +424,11 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 			return;
 		}
 		const Sighting& s = pass[sighting_of[idx]];
-		Eigen::Matrix3d hx, hy;
+		MatDx3 hx;
+		MatD hy;
 		predict(s, idx, &hx, &hy);
-		Hx.asEigen() = s.W * hx;
-		Hy.asEigen() = s.W * hy;
+		Hx.asEigen() = whitening(s) * hx;
+		Hy.asEigen() = whitening(s) * hy;
 	}
 
 	void OnGetObservationsAndDataAssociation(
@@ -353,37 +440,38 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 		for (std::size_t i = 0; i < pass.size(); ++i)
 		{
 			const Sighting& s = pass[i];
+			const VecD z = s.z.head<D>();
 			const auto it = id_to_idx.find(s.id);
 			if (it == id_to_idx.end())
 			{
-				KFArray_OBS z;
-				z.asEigen() = s.z;
-				out_z.push_back(z);
+				KFArray_OBS zz;
+				zz.asEigen() = z;
+				out_z.push_back(zz);
 				out_da.push_back(-1);
 				new_queue.push_back(i);
 				++used;
 				continue;
 			}
 			const std::size_t idx = it->second;
-			const Eigen::Vector3d h = predict(s, idx, nullptr, nullptr);
-			Eigen::Vector3d nu = s.z - h;
+			const VecD h = predict(s, idx, nullptr, nullptr);
+			VecD nu = z - h;
 			nu[1] = wrapToPi(nu[1]);
-			nu[2] = s.point ? 0.0 : wrapToPi(nu[2]);
-			const Eigen::Vector3d w = s.W * nu;
+			if (D == 3) nu[D - 1] = s.point ? 0.0 : wrapToPi(nu[D - 1]);
+			const VecD w = whitening(s) * nu;
 			std::size_t k = 0;
 			while (k < in_idx_S.size() && in_idx_S[k] != idx) ++k;
 			if (k == in_idx_S.size()) throw std::logic_error("ekf-slam: sighted landmark not predicted");
-			const Eigen::Matrix3d S = in_S.asEigen().block<3, 3>(3 * k, 3 * k);
+			const MatD S = in_S.asEigen().template block<D, D>(D * k, D * k);
 			const double d2 = w.dot(S.ldlt().solve(w));
-			if (!(d2 <= gateThreshold(opts.gate_probability, s.point ? 2 : 3)))
+			if (!(d2 <= gateThreshold(opts.gate_probability, (D == 2 || s.point) ? 2 : 3)))
 			{
 				++rejected;
 				continue;
 			}
 			// MRPT's innovation is out_z - W h = W nu: the wrapped innovation.
-			KFArray_OBS z;
-			z.asEigen() = s.W * (h + nu);
-			out_z.push_back(z);
+			KFArray_OBS zz;
+			zz.asEigen() = whitening(s) * (h + nu);
+			out_z.push_back(zz);
 			out_da.push_back(static_cast<int>(idx));
 			++used;
 			addHeight(idx, s);
@@ -397,12 +485,12 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 		if (new_cursor >= new_queue.size())
 			throw std::logic_error("ekf-slam: more new landmarks than queued sightings");
 		const Sighting& s = pass[new_queue[new_cursor]];
-		if ((in_z.asEigen() - s.z).cwiseAbs().maxCoeff() != 0.0)
+		if ((in_z.asEigen() - s.z.head<D>()).cwiseAbs().maxCoeff() != 0.0)
 			throw std::logic_error("ekf-slam: new landmark out of order");
 		Eigen::Matrix3d Jx, Jz;
 		Eigen::Vector3d l = slamInverseObservation(robot(), s.sensor, s.z, &Jx, &Jz);
 		Eigen::Matrix3d P = Jz * s.C * Jz.transpose();
-		if (s.point)
+		if (D == 3 && s.point)
 		{
 			// The never-observed yaw: 0, fixed variance, uncorrelated.
 			l[2] = 0;
@@ -411,10 +499,17 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 			P = Jz * s.C * Jz.transpose();
 			P(2, 2) = std::pow(opts.point_yaw_sigma_deg * kDeg, 2);
 		}
-		yn.asEigen() = l;
-		dyn_dxv.asEigen() = Jx;
-		dyn_dhn.asEigen() = Jz;
-		dyn_dhn_R_dyn_dhnT.asEigen() = P;
+		if (D == 2)
+		{
+			// Range and bearing only (the sighting's full C when it is coded
+			// only matters through its range-bearing block).
+			const Eigen::Matrix2d J = Jz.topLeftCorner<2, 2>();
+			P.topLeftCorner<2, 2>() = J * s.C.topLeftCorner<2, 2>() * J.transpose();
+		}
+		yn.asEigen() = l.head<D>();
+		dyn_dxv.asEigen() = Jx.topRows<D>();
+		dyn_dhn.asEigen() = Jz.topLeftCorner<D, D>();
+		dyn_dhn_R_dyn_dhnT.asEigen() = P.topLeftCorner<D, D>();
 		use_dyn_dhn_jacobian = false;  // the per-sighting covariance, not R = I
 	}
 
@@ -428,40 +523,9 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, 3, 3, 3>
 	}
 
 	void OnNormalizeStateVector() override { normalize(); }
-
-   public:
-	// Wraps the yaws, symmetrises P and checks its diagonal.
-	void normalize()
-	{
-		for (std::size_t i = 2; i < static_cast<std::size_t>(m_xkk.size()); i += 3)
-			m_xkk[i] = wrapToPi(m_xkk[i]);
-		auto P = m_pkk.asEigen();
-		const Eigen::Index n = P.rows();
-		for (Eigen::Index r = 0; r < n; ++r)
-		{
-			for (Eigen::Index c = r + 1; c < n; ++c)
-			{
-				const double m = 0.5 * (P(r, c) + P(c, r));
-				P(r, c) = m;
-				P(c, r) = m;
-			}
-			if (!std::isfinite(P(r, r)) || P(r, r) < -opts.pd_tolerance)
-				throw std::runtime_error(
-					"ekf-slam: covariance lost positive definiteness (diagonal " +
-					std::to_string(r) + " = " + std::to_string(P(r, r)) + ")");
-			if (P(r, r) < 0) P(r, r) = 0;
-		}
-	}
-
-	void addHeight(std::size_t idx, const Sighting& s)
-	{
-		if (idx >= info.size() || info[idx].z_prior || !std::isfinite(s.height_m)) return;
-		info[idx].z_sum += s.height_m;
-		++info[idx].z_count;
-	}
 };
 
-// Whitening matrix W = L^-1 with C = L L^T; throws on a non-PD C.
+// Whitening matrix W = L^-1 with C = L L^T; false on a non-PD C.
 bool whiten(Sighting& s)
 {
 	if (!s.C.allFinite() || !s.z.allFinite()) return false;
@@ -478,13 +542,87 @@ bool whiten(Sighting& s)
 class EkfSlam::Impl
 {
    public:
-	SlamKF kf;
+	EkfSlamOptions opts;
+	std::unique_ptr<SlamKF<3>> k3;  //!< full landmarks
+	std::unique_ptr<SlamKF<2>> k2;  //!< point landmarks (range-bearing-only data)
+	std::optional<PoseEstimate> initial;
+	LandmarkMap prior;
+	/** The Kalman template's options (TKF_options holds a reference, so it
+	 * cannot be copied whole). */
+	struct KfOptions
+	{
+		mrpt::bayes::TKFMethod method = mrpt::bayes::kfEKFAlaDavison;
+		int IKF_iterations = 5;
+		bool enable_profiler = false;
+		bool use_analytic_transition_jacobian = true;
+		bool use_analytic_observation_jacobian = true;
+		bool debug_verify_analytic_jacobians = false;
+		double debug_verify_analytic_jacobians_threshold = 1e-2;
+	} kfo;
 	bool initialized = true;
+
+	template <class F>
+	auto visit(F&& f) const
+	{
+		if (k3) return f(*k3);
+		return f(*k2);
+	}
+	bool created() const { return k3 || k2; }
+
+	// Builds the filter of landmark dimension D with the initial pose and the
+	// prior map.
+	template <std::size_t D>
+	void build(std::unique_ptr<SlamKF<D>>& kf)
+	{
+		kf = std::make_unique<SlamKF<D>>();
+		kf->opts = opts;
+		auto& k = kf->KF_options;
+		k.method = kfo.method;
+		k.IKF_iterations = kfo.IKF_iterations;
+		k.enable_profiler = kfo.enable_profiler;
+		k.use_analytic_transition_jacobian = kfo.use_analytic_transition_jacobian;
+		k.use_analytic_observation_jacobian = kfo.use_analytic_observation_jacobian;
+		k.debug_verify_analytic_jacobians = kfo.debug_verify_analytic_jacobians;
+		k.debug_verify_analytic_jacobians_threshold = kfo.debug_verify_analytic_jacobians_threshold;
+		if (initial && initial->initialized)
+		{
+			kf->m_xkk[0] = initial->mean.x();
+			kf->m_xkk[1] = initial->mean.y();
+			kf->m_xkk[2] = initial->mean.phi();
+			kf->m_pkk.asEigen() = 0.5 * (initial->cov + initial->cov.transpose());
+		}
+		if (prior.landmarks.empty()) return;
+		const std::size_t n = 3 + D * prior.landmarks.size();
+		Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
+		P.topLeftCorner<3, 3>() = kf->m_pkk.asEigen();
+		kf->m_xkk.resize(n);
+		for (std::size_t i = 0; i < prior.landmarks.size(); ++i)
+		{
+			const MapLandmark& l = prior.landmarks[i];
+			const std::size_t o = 3 + D * i;
+			kf->m_xkk[o] = l.x_m;
+			kf->m_xkk[o + 1] = l.y_m;
+			P(o, o) = P(o + 1, o + 1) = opts.prior_sigma_xy * opts.prior_sigma_xy;
+			if (D == 3)
+			{
+				kf->m_xkk[o + D - 1] = wrapToPi(l.yaw_rad);
+				P(o + D - 1, o + D - 1) = std::pow(opts.prior_sigma_yaw_deg * kDeg, 2);
+			}
+			kf->id_to_idx[l.id] = i;
+			kf->info.push_back(LandmarkInfo{l.id, l.z_m, 1, true});
+		}
+		kf->m_pkk.setSize(n, n);
+		kf->m_pkk.asEigen() = P;
+		// Full landmarks: without an initial pose the first coded sighting of
+		// a prior landmark places the robot. Points cannot: the robot starts
+		// where the initial pose (default: the origin) says.
+		initialized = D == 2 || (initial && initial->initialized);
+	}
 
 	// Sightings of a frame, in the order of its observations.
 	std::vector<Sighting> collect(const mrpt::obs::CSensoryFrame& sf, int& rejected) const
 	{
-		const EkfSlamOptions& o = kf.opts;
+		const EkfSlamOptions& o = opts;
 		bool has_coded = false;
 		for (const auto& obs : sf)
 			if (std::dynamic_pointer_cast<CObservationCodedLandmarks>(obs)) has_coded = true;
@@ -558,7 +696,7 @@ class EkfSlam::Impl
 
 	// Places the robot from a coded sighting of a prior landmark (pose fix
 	// with C_R, plus the landmark's own uncertainty and correlation).
-	void anchor(const Sighting& s, std::size_t idx)
+	void anchor(SlamKF<3>& kf, const Sighting& s, std::size_t idx)
 	{
 		const Eigen::Vector3d lm = kf.landmark(idx);
 		const mrpt::poses::CPose2D world_T_landmark(lm[0], lm[1], lm[2]);
@@ -579,6 +717,76 @@ class EkfSlam::Impl
 		P.block(3, 0, n - 3, 3) = cross.transpose();
 		P.topLeftCorner<3, 3>() = C_world + J * P.block<3, 3>(o, o) * J.transpose();
 	}
+
+	template <std::size_t D>
+	StepStats step(
+		SlamKF<D>& kf, const mrpt::obs::CActionRobotMovement2D* odometry,
+		std::vector<Sighting> all, StepStats st)
+	{
+		kf.used = 0;
+		kf.rejected = 0;
+		if (odometry && odometry->poseChange)
+		{
+			const mrpt::poses::CPosePDFGaussian g(*odometry->poseChange);
+			kf.odo_mean = g.mean;
+			kf.odo_cov = g.cov.asEigen();
+		}
+		else
+		{
+			const double vxy = opts.std_no_odo_xy * opts.std_no_odo_xy;
+			kf.odo_mean = mrpt::poses::CPose2D();
+			kf.odo_cov =
+				Eigen::Vector3d(vxy, vxy, std::pow(opts.std_no_odo_yaw_deg * kDeg, 2)).asDiagonal();
+		}
+		if (!initialized)
+		{
+			if constexpr (D == 3)
+			{
+				// A prior map and no initial pose: wait for a coded sighting
+				// of a prior landmark; odometry before it is meaningless.
+				for (std::size_t i = 0; i < all.size(); ++i)
+				{
+					const auto it = kf.id_to_idx.find(all[i].id);
+					if (all[i].point || it == kf.id_to_idx.end()) continue;
+					anchor(kf, all[i], it->second);
+					kf.normalize();
+					initialized = true;
+					st.reinitialized = true;
+					++st.used;
+					all.erase(all.begin() + static_cast<std::ptrdiff_t>(i));
+					break;
+				}
+			}
+			if (!initialized)
+			{
+				st.unknown_id += static_cast<int>(all.size());
+				return st;
+			}
+			kf.odo_mean = mrpt::poses::CPose2D();  // the fix is at this frame
+			kf.odo_cov.setZero();
+		}
+		// Pass k holds the k-th sighting of each ID in this frame: one
+		// observation per landmark per Kalman iteration (the whitening is per
+		// landmark); later passes skip the prediction.
+		std::map<int, int> seen;
+		std::vector<std::vector<Sighting>> passes(1);
+		for (auto& s : all)
+		{
+			const int k = seen[s.id]++;
+			if (static_cast<int>(passes.size()) <= k) passes.resize(k + 1);
+			passes[k].push_back(std::move(s));
+		}
+		for (std::size_t p = 0; p < passes.size(); ++p)
+		{
+			kf.pass = std::move(passes[p]);
+			kf.skip_prediction = p > 0;
+			kf.iterate();
+		}
+		kf.pass.clear();
+		st.used += kf.used;
+		st.rejected += kf.rejected;
+		return st;
+	}
 };
 
 EkfSlam::EkfSlam(
@@ -588,38 +796,23 @@ EkfSlam::EkfSlam(
 	: impl_(std::make_unique<Impl>())
 {
 	options.validate();
-	SlamKF& kf = impl_->kf;
-	kf.opts = options;
-	if (kf_cfg) kf.KF_options.loadFromConfigFile(*kf_cfg, kf_section);
-	if (initial && initial->initialized)
+	Impl& m = *impl_;
+	m.opts = options;
+	m.initial = initial;
+	m.prior = prior;
+	if (kf_cfg)
 	{
-		kf.m_xkk[0] = initial->mean.x();
-		kf.m_xkk[1] = initial->mean.y();
-		kf.m_xkk[2] = initial->mean.phi();
-		kf.m_pkk.asEigen() = 0.5 * (initial->cov + initial->cov.transpose());
+		SlamKF<3> probe;  // MRPT's own loader, defaults as ours
+		auto& k = probe.KF_options;
+		k.loadFromConfigFile(*kf_cfg, kf_section);
+		m.kfo = {k.method, k.IKF_iterations, k.enable_profiler, k.use_analytic_transition_jacobian,
+			k.use_analytic_observation_jacobian, k.debug_verify_analytic_jacobians,
+			k.debug_verify_analytic_jacobians_threshold};
 	}
-	if (!prior.landmarks.empty())
-	{
-		const std::size_t n = 3 + 3 * prior.landmarks.size();
-		Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n, n);
-		P.topLeftCorner<3, 3>() = kf.m_pkk.asEigen();
-		kf.m_xkk.resize(n);
-		for (std::size_t i = 0; i < prior.landmarks.size(); ++i)
-		{
-			const MapLandmark& l = prior.landmarks[i];
-			const std::size_t o = 3 + 3 * i;
-			kf.m_xkk[o] = l.x_m;
-			kf.m_xkk[o + 1] = l.y_m;
-			kf.m_xkk[o + 2] = wrapToPi(l.yaw_rad);
-			P(o, o) = P(o + 1, o + 1) = options.prior_sigma_xy * options.prior_sigma_xy;
-			P(o + 2, o + 2) = std::pow(options.prior_sigma_yaw_deg * kDeg, 2);
-			kf.id_to_idx[l.id] = i;
-			kf.info.push_back(LandmarkInfo{l.id, l.z_m, 1, true});
-		}
-		kf.m_pkk.setSize(n, n);
-		kf.m_pkk.asEigen() = P;
-		impl_->initialized = initial && initial->initialized;
-	}
+	if (options.landmarks == SlamLandmarks::Full) m.build(m.k3);
+	else if (options.landmarks == SlamLandmarks::Point)
+		m.build(m.k2);
+	// Auto: decided by the first frame with sightings.
 }
 
 EkfSlam::~EkfSlam() = default;
@@ -627,118 +820,120 @@ EkfSlam::~EkfSlam() = default;
 StepStats EkfSlam::step(
 	const mrpt::obs::CActionRobotMovement2D* odometry, const mrpt::obs::CSensoryFrame& sf)
 {
-	SlamKF& kf = impl_->kf;
+	Impl& m = *impl_;
 	StepStats st;
-	kf.used = 0;
-	kf.rejected = 0;
-	std::vector<Sighting> all = impl_->collect(sf, st.rejected);
-
-	if (odometry && odometry->poseChange)
+	std::vector<Sighting> all = m.collect(sf, st.rejected);
+	if (!m.created())
 	{
-		const mrpt::poses::CPosePDFGaussian g(*odometry->poseChange);
-		kf.odo_mean = g.mean;
-		kf.odo_cov = g.cov.asEigen();
-	}
-	else
-	{
-		kf.odo_mean = mrpt::poses::CPose2D();
-		kf.odo_cov = Eigen::Vector3d(
-						 kf.opts.std_no_odo_xy * kf.opts.std_no_odo_xy,
-						 kf.opts.std_no_odo_xy * kf.opts.std_no_odo_xy,
-						 std::pow(kf.opts.std_no_odo_yaw_deg * kDeg, 2))
-						 .asDiagonal();
-	}
-
-	if (!impl_->initialized)
-	{
-		// A prior map and no initial pose: wait for a coded sighting of a
-		// prior landmark; odometry before it is meaningless.
-		for (std::size_t i = 0; i < all.size(); ++i)
+		if (all.empty())
 		{
-			const auto it = kf.id_to_idx.find(all[i].id);
-			if (all[i].point || it == kf.id_to_idx.end()) continue;
-			impl_->anchor(all[i], it->second);
-			kf.normalize();
-			impl_->initialized = true;
-			st.reinitialized = true;
-			++st.used;
-			all.erase(all.begin() + static_cast<std::ptrdiff_t>(i));
-			break;
-		}
-		if (!impl_->initialized)
-		{
-			st.unknown_id += static_cast<int>(all.size());
+			// Nothing to decide the landmark kind by: dead-reckon the pose.
+			if (odometry && odometry->poseChange)
+			{
+				const mrpt::poses::CPosePDFGaussian g(*odometry->poseChange);
+				PoseEstimate e = m.initial.value_or(PoseEstimate{});
+				const double c = std::cos(e.mean.phi()), s = std::sin(e.mean.phi());
+				Eigen::Matrix3d F = Eigen::Matrix3d::Identity(), R = Eigen::Matrix3d::Identity();
+				F(0, 2) = -g.mean.x() * s - g.mean.y() * c;
+				F(1, 2) = g.mean.x() * c - g.mean.y() * s;
+				R.topLeftCorner<2, 2>() << c, -s, s, c;
+				e.cov = F * e.cov * F.transpose() + R * g.cov.asEigen() * R.transpose();
+				e.mean = e.mean + g.mean;
+				e.initialized = true;
+				m.initial = e;
+			}
 			return st;
 		}
-		kf.odo_mean = mrpt::poses::CPose2D();  // the fix is at this frame
-		kf.odo_cov.setZero();
+		bool any_coded = false;
+		for (const auto& s : all) any_coded |= !s.point;
+		if (any_coded) m.build(m.k3);
+		else
+			m.build(m.k2);
 	}
-
-	// Pass k holds the k-th sighting of each ID in this frame: one
-	// observation per landmark per Kalman iteration (the whitening is per
-	// landmark); later passes skip the prediction.
-	std::map<int, int> seen;
-	std::vector<std::vector<Sighting>> passes(1);
-	for (auto& s : all)
-	{
-		const int k = seen[s.id]++;
-		if (static_cast<int>(passes.size()) <= k) passes.resize(k + 1);
-		passes[k].push_back(std::move(s));
-	}
-	for (std::size_t p = 0; p < passes.size(); ++p)
-	{
-		kf.pass = std::move(passes[p]);
-		kf.skip_prediction = p > 0;
-		kf.iterate();
-	}
-	kf.pass.clear();
-	st.used += kf.used;
-	st.rejected += kf.rejected;
-	return st;
+	if (m.k2)
+		for (auto& s : all) s.point = true;  // coded sightings feed range and bearing only
+	if (m.k3) return m.step(*m.k3, odometry, std::move(all), st);
+	return m.step(*m.k2, odometry, std::move(all), st);
 }
 
 PoseEstimate EkfSlam::estimate() const
 {
-	const SlamKF& kf = impl_->kf;
-	PoseEstimate e;
-	e.initialized = impl_->initialized;
-	e.mean = mrpt::poses::CPose2D(kf.m_xkk[0], kf.m_xkk[1], kf.m_xkk[2]);
-	e.cov = kf.m_pkk.asEigen().topLeftCorner<3, 3>();
-	return e;
+	const Impl& m = *impl_;
+	if (!m.created())
+	{
+		PoseEstimate e = m.initial.value_or(PoseEstimate{});
+		e.initialized = true;
+		return e;
+	}
+	return m.visit(
+		[&](const auto& kf)
+		{
+			PoseEstimate e;
+			e.initialized = m.initialized;
+			e.mean = mrpt::poses::CPose2D(kf.m_xkk[0], kf.m_xkk[1], kf.m_xkk[2]);
+			e.cov = kf.m_pkk.asEigen().template topLeftCorner<3, 3>();
+			return e;
+		});
 }
 
 std::vector<MappedLandmark> EkfSlam::landmarks() const
 {
-	const SlamKF& kf = impl_->kf;
-	std::vector<MappedLandmark> out;
-	const std::size_t n = kf.getNumberOfLandmarksInTheMap();
-	out.reserve(n);
-	for (std::size_t i = 0; i < n; ++i)
-	{
-		MappedLandmark m;
-		const Eigen::Vector3d l = kf.landmark(i);
-		m.landmark.id = kf.info[i].id;
-		m.landmark.x_m = l[0];
-		m.landmark.y_m = l[1];
-		m.landmark.yaw_rad = l[2];
-		m.landmark.z_m = kf.info[i].z_count > 0 ? kf.info[i].z_sum / kf.info[i].z_count : 0.0;
-		m.cov = kf.m_pkk.asEigen().block<3, 3>(3 + 3 * i, 3 + 3 * i);
-		out.push_back(m);
-	}
-	return out;
+	const Impl& m = *impl_;
+	if (!m.created()) return {};
+	return m.visit(
+		[&](const auto& kf)
+		{
+			std::vector<MappedLandmark> out;
+			const std::size_t n = kf.getNumberOfLandmarksInTheMap();
+			out.reserve(n);
+			for (std::size_t i = 0; i < n; ++i)
+			{
+				MappedLandmark lm;
+				const Eigen::Vector3d l = kf.landmark(i);
+				lm.landmark.id = kf.info[i].id;
+				lm.landmark.x_m = l[0];
+				lm.landmark.y_m = l[1];
+				lm.landmark.yaw_rad = l[2];
+				lm.landmark.z_m =
+					kf.info[i].z_count > 0 ? kf.info[i].z_sum / kf.info[i].z_count : 0.0;
+				lm.cov = kf.landmarkCov(i);
+				out.push_back(lm);
+			}
+			return out;
+		});
 }
 
-std::size_t EkfSlam::landmarkCount() const { return impl_->kf.getNumberOfLandmarksInTheMap(); }
+std::size_t EkfSlam::landmarkCount() const
+{
+	if (!impl_->created()) return 0;
+	return impl_->visit([](const auto& kf) { return kf.getNumberOfLandmarksInTheMap(); });
+}
 
-Eigen::MatrixXd EkfSlam::fullCovariance() const { return impl_->kf.m_pkk.asEigen(); }
+std::size_t EkfSlam::landmarkDimension() const
+{
+	if (!impl_->created()) return 0;
+	return impl_->k3 ? 3 : 2;
+}
+
+Eigen::MatrixXd EkfSlam::fullCovariance() const
+{
+	if (!impl_->created()) return impl_->initial.value_or(PoseEstimate{}).cov;
+	return impl_->visit([](const auto& kf) { return Eigen::MatrixXd(kf.m_pkk.asEigen()); });
+}
 
 double EkfSlam::meanKalmanIterationMs() const
 {
-	auto& kf = const_cast<SlamKF&>(impl_->kf);
-	return 1e3 * kf.getProfiler().getMeanTime("KF:complete_step");
+	if (!impl_->created()) return 0;
+	return impl_->visit(
+		[](const auto& kf)
+		{ return 1e3 * const_cast<std::decay_t<decltype(kf)>&>(kf).getProfiler().getMeanTime("KF:complete_step"); });
 }
 
-std::size_t EkfSlam::kalmanIterations() const { return impl_->kf.iterations; }
+std::size_t EkfSlam::kalmanIterations() const
+{
+	if (!impl_->created()) return 0;
+	return impl_->visit([](const auto& kf) { return kf.iterations; });
+}
 
 // ---------------------------------------------------------------------------
 // Factory

@@ -12,6 +12,11 @@
  *   the same (x, y, yaw) block; its yaw is never observed by range-bearing
  *   readings: it gets a fixed variance point_yaw_sigma^2 with no correlation
  *   to anything, and the zero column of the Jacobian keeps it untouched.
+ * - Range-bearing-only data (MRPT's kf-slam_demo) runs by default in a
+ *   second instantiation with point landmarks, CKalmanFilterCapable<3,2,2,3>
+ *   (ini `landmarks`): two thirds of the state and of the scalar updates, so
+ *   the same cost per step as CRangeBearingKFSLAM2D's model. Coded sightings
+ *   fed to it contribute their range and bearing (l2, phi1) only.
  * - Per-sighting covariances in MRPT's single-R template: each observation is
  *   whitened (z' = W z with W = chol(C)^-1, so R = I), exact for a linear(ised)
  *   model and what lets MRPT's scalar-at-once update (kfEKFAlaDavison, O(n^2)
@@ -53,11 +58,22 @@ enum class SlamInput
 	Both  //!< everything (only for independent sensors)
 };
 
+/** The landmark state of EKF-SLAM. */
+enum class SlamLandmarks
+{
+	/** Full when the first frame with sightings has a coded sighting, else
+	 * Point. */
+	Auto,
+	Full,  //!< (x, y, yaw) per landmark, CKalmanFilterCapable<3,3,3,3>
+	Point  //!< (x, y) per landmark, CKalmanFilterCapable<3,2,2,3>
+};
+
 /** Options of EKF-SLAM (ini section `[ekf_slam]`; the Kalman template's own
  * options, e.g. `method`, `enable_profiler`, in `[ekf_slam_kf]`). */
 struct EkfSlamOptions : public mrpt::config::CLoadableOptions
 {
 	SlamInput input = SlamInput::Auto;  //!< which observations to fuse
+	SlamLandmarks landmarks = SlamLandmarks::Auto;  //!< landmark state (ini: auto, full, point)
 	/** Chi-square gate: a sighting of a mapped landmark is fused when its
 	 * squared Mahalanobis innovation distance is below
 	 * chi2inv(gate_probability, dof), dof = 3 for L, 2 for range-bearing.
@@ -148,9 +164,12 @@ class EkfSlam : public Localizer
 	PoseEstimate estimate() const override;
 	std::vector<MappedLandmark> landmarks() const override;
 
+	/** Landmark state dimension: 3 (x, y, yaw), 2 (points), 0 before the
+	 * filter is built (SlamLandmarks::Auto before the first sighting). */
+	std::size_t landmarkDimension() const;
 	/** Number of landmarks in the state. */
 	std::size_t landmarkCount() const;
-	/** The full state covariance (3 + 3 N square). */
+	/** The full state covariance (3 + D N square, D = landmarkDimension()). */
 	Eigen::MatrixXd fullCovariance() const;
 	/** Mean time of one Kalman iteration [ms] from MRPT's profiler ("KF:complete_step"),
 	 * 0 unless the Kalman options enable the profiler. */
