@@ -96,6 +96,7 @@ TEST(Components, HandMadeMask)
 	cv::rectangle(mask, cv::Rect(60, 40, 10, 10), 255, cv::FILLED);
 	const cv::Mat img(120, 160, CV_8UC3, kGreen);
 	ComponentParams p;
+	p.max_frame_ratio = 1;  // no frame in this image: frame evidence off
 	cv::Mat labels;
 	int n = 0;
 	const auto c = findCandidates(mask, 2, img, p, &labels, &n);
@@ -123,9 +124,25 @@ TEST(Components, ARingIsCompactEnoughAndALShapeIsNot)
 	cv::rectangle(mask, cv::Rect(50, 50, 45, 3), 255, cv::FILLED);  // a thin L
 	cv::rectangle(mask, cv::Rect(50, 50, 3, 45), 255, cv::FILLED);
 	const cv::Mat img(200, 200, CV_8UC3, kGreen);
-	const auto c = findCandidates(mask, 2, img, ComponentParams());
+	ComponentParams p;
+	p.max_frame_ratio = 1;
+	const auto c = findCandidates(mask, 2, img, p);
 	ASSERT_EQ(c.size(), 1u);
 	EXPECT_NEAR(c[0].compactness, 0.32, 0.03);
+}
+
+TEST(Components, FrameEvidence)
+{
+	// The crafted landmark has its frame; the same fill on grey or on white
+	// has none.
+	const cv::Mat lm = craftedLandmark(0);
+	EXPECT_EQ(findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(), 1u);
+	for (const cv::Scalar& bg : {cv::Scalar(128, 128, 128), kWhite})
+	{
+		cv::Mat img(180, 180, CV_8UC3, bg);
+		cv::rectangle(img, cv::Rect(50, 50, 80, 80), kGreen, cv::FILLED);
+		EXPECT_TRUE(findCandidates(segmentColour(img, SegmentationParams()), 2, img, ComponentParams()).empty());
+	}
 }
 
 // ------------------------------------------------------------------ edgels

@@ -51,6 +51,8 @@ void forEachField(Options& o, F&& f)
 	f("components.max_elongation", o.components.max_elongation);
 	f("components.roi_grow_fraction", o.components.roi_grow_fraction);
 	f("components.roi_grow_px", o.components.roi_grow_px);
+	f("components.max_frame_ratio", o.components.max_frame_ratio);
+	f("components.max_side_frame_ratio", o.components.max_side_frame_ratio);
 	f("components.max_candidates", o.components.max_candidates);
 	f("edgels.min_gradient", o.edgels.min_gradient);
 	f("edgels.rel_gradient", o.edgels.rel_gradient);
@@ -95,6 +97,8 @@ void DetectorOptions::validate() const
 	require(c.max_compactness >= 1.0 / 6, "components.max_compactness", ">= 1/6 (a filled square)");
 	require(c.max_elongation >= 1, "components.max_elongation", ">= 1");
 	require(c.roi_grow_fraction >= 0 && c.roi_grow_px >= 0, "components.roi_grow_*", ">= 0");
+	require(c.max_frame_ratio > 0 && c.max_side_frame_ratio >= c.max_frame_ratio, "components.max_frame_ratio/max_side_frame_ratio",
+		"> 0 and max_side_frame_ratio >= max_frame_ratio");
 	require(c.max_candidates >= 1, "components.max_candidates", ">= 1");
 	require(edgels.min_gradient > 0 && edgels.rel_gradient >= 0, "edgels.min_gradient/rel_gradient", "> 0 / >= 0");
 	require(edgels.min_edgels >= 2, "edgels.min_edgels", ">= 2");

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -156,6 +157,53 @@ struct Moments
 	int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;  // inclusive bbox
 };
 
+/** Darkest G along a ray of \a n pixels from (x, y) in direction (dx, dy);
+ * -1 when the ray leaves the image at once. */
+int darkestAlong(const cv::Mat& bgr, int x, int y, int dx, int dy, int n)
+{
+	int best = -1;
+	for (int i = 0; i < n; ++i, x += dx, y += dy)
+	{
+		if (x < 0 || y < 0 || x >= bgr.cols || y >= bgr.rows) break;
+		const int g = bgr.ptr<uint8_t>(y)[3 * x + 1];
+		if (best < 0 || g < best) best = g;
+	}
+	return best;
+}
+
+bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const ComponentParams& p)
+{
+	if (p.max_frame_ratio >= 1) return true;
+	std::array<double, 4> side{};
+	const int x0 = c.bbox.x, y0 = c.bbox.y, x1 = c.bbox.x + c.bbox.width - 1, y1 = c.bbox.y + c.bbox.height - 1;
+	// Rays start a grid step inside the box (its sides are a step coarse) and
+	// reach a frame width (1/8 of the side) plus margins beyond it.
+	const int nx = step + 3 + c.bbox.width / 6, ny = step + 3 + c.bbox.height / 6;
+	for (int k = 0; k < 4; ++k)
+	{
+		std::array<int, 3> m{};
+		for (int j = 0; j < 3; ++j)
+		{
+			const double t = 0.25 * (j + 1);
+			const int xm = x0 + static_cast<int>(t * (x1 - x0)), ym = y0 + static_cast<int>(t * (y1 - y0));
+			switch (k)
+			{
+				case 0: m[j] = darkestAlong(bgr, xm, y0 + step, 0, -1, ny); break;  // top
+				case 1: m[j] = darkestAlong(bgr, x1 - step, ym, 1, 0, nx); break;  // right
+				case 2: m[j] = darkestAlong(bgr, xm, y1 - step, 0, 1, ny); break;  // bottom
+				default: m[j] = darkestAlong(bgr, x0 + step, ym, -1, 0, nx); break;  // left
+			}
+			if (m[j] < 0) return false;
+		}
+		std::sort(m.begin(), m.end());
+		side[k] = m[1];
+	}
+	std::array<double, 4> sorted = side;
+	std::sort(sorted.begin(), sorted.end());
+	if (0.5 * (sorted[0] + sorted[1]) > p.max_frame_ratio * c.fill_g) return false;
+	return sorted[3] <= p.max_side_frame_ratio * c.fill_g;
+}
+
 inline double sumSquares(double k) { return k * (k + 1) * (2 * k + 1) / 6; }  // 0^2 + ... + k^2
 }  // namespace
 
@@ -283,6 +331,13 @@ std::vector<Candidate> findCandidates(
 			for (int x = runs[i].x0; x < runs[i].x1; ++x) sg[run_comp[i]] += px[3 * x * step + 1];
 		}
 		for (auto& c : out) c.fill_g = sg[c.label - 1] / comps[c.label - 1].m0;
+		// Frame evidence: a landmark's fill is surrounded by the dark frame.
+		// Along short rays outwards from each side of the bounding box, the
+		// darkest G must be dark: cheap, and it spares the later stages most
+		// green things of a scene (posters, shapes on a wall).
+		out.erase(std::remove_if(out.begin(), out.end(),
+					  [&](const Candidate& c) { return !frameEvidence(bgr, c, step, p); }),
+			out.end());
 	}
 	std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.area_px > b.area_px; });
 	if (static_cast<int>(out.size()) > p.max_candidates) out.resize(p.max_candidates);

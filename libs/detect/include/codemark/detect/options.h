@@ -60,6 +60,13 @@ struct ComponentParams
 	double roi_grow_fraction = 0.3;
 	/** ... plus this many pixels (blur, grid step) [px]. */
 	int roi_grow_px = 4;
+	/** Frame evidence: along three short rays out of each side of the
+	 * component's box, the darkest G (median of the three) must be dark. The
+	 * mean of the two darkest sides must stay below max_frame_ratio times the
+	 * fill's G, and every side below max_side_frame_ratio times it (a side
+	 * under 2 px wide at 5 m and 60 deg does not reach black). 1 disables. */
+	double max_frame_ratio = 0.4;
+	double max_side_frame_ratio = 0.7;
 	/** At most this many candidates are examined per image (largest first). */
 	int max_candidates = 64;
 };
