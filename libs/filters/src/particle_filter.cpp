@@ -250,8 +250,11 @@ StepStats ParticleFilterLocalizer::step(
 
 		const bool collapsed = m_opts.inject_ess_threshold > 0 &&
 			m_stats.ESS_beforeResample < m_opts.inject_ess_threshold;
-		const bool lost = m_opts.inject_after_unexplained > 0 &&
-			m_unexplained >= m_opts.inject_after_unexplained;
+		// Before the first convergence one unexplained frame suffices: with
+		// the uniform mixture, a spread-out cloud far from every fix scores
+		// the same floor everywhere and its ESS says nothing.
+		const int patience = m_converged ? m_opts.inject_after_unexplained : 1;
+		const bool lost = m_opts.inject_after_unexplained > 0 && m_unexplained >= patience;
 		if ((collapsed || lost) && injectAroundFixes(sf))
 		{
 			stats.reinitialized = true;
@@ -307,22 +310,36 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 	auto& parts = m_pdf.m_particles;
 	if (fixes.empty() || parts.empty()) return false;
 
-	// Replace the lowest-weight particles, cycling over the fixes; then
-	// equal weights: the frame's information is in where the samples are.
-	const size_t n = std::max<size_t>(
-		1, static_cast<size_t>(std::lround(m_opts.inject_fraction * double(parts.size()))));
+	// Replace the lowest-weight particles, cycling over the fixes. Each new
+	// sample is weighted by this frame's likelihood at it, with the prior
+	// weight of the current best particle: the injected samples compete
+	// with the survivors on the same evidence.
+	auto frameLogLik = [&](const mrpt::math::TPose2D& p) {
+		const mrpt::poses::CPose3D x{mrpt::poses::CPose2D(p)};
+		double ll = 0;
+		for (const auto& o : observations) ll += m_map->computeObservationLikelihood(*o, x);
+		return ll;
+	};
+	const auto best = std::max_element(
+		parts.begin(), parts.end(), [](const auto& a, const auto& b) { return a.log_w < b.log_w; });
+	const double prior_best = best->log_w - frameLogLik(best->d);
+	const size_t n = std::min(
+		parts.size(),
+		std::max<size_t>(1, static_cast<size_t>(std::lround(m_opts.inject_fraction * double(parts.size())))));
 	std::vector<size_t> order(parts.size());
 	std::iota(order.begin(), order.end(), size_t(0));
 	std::nth_element(
-		order.begin(), order.begin() + static_cast<std::ptrdiff_t>(std::min(n, order.size()) - 1),
-		order.end(), [&](size_t a, size_t b) { return parts[a].log_w < parts[b].log_w; });
-	for (size_t k = 0; k < std::min(n, parts.size()); ++k)
+		order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n - 1), order.end(),
+		[&](size_t a, size_t b) { return parts[a].log_w < parts[b].log_w; });
+	for (size_t k = 0; k < n; ++k)
 	{
 		const Fix& f = fixes[k % fixes.size()];
 		const Eigen::Vector3d v = drawGaussian(f.mean, f.cov);
-		parts[order[k]].d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
+		auto& p = parts[order[k]];
+		p.d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
+		p.log_w = prior_best + frameLogLik(p.d);
 	}
-	for (auto& p : parts) p.log_w = 0;
+	m_pdf.normalizeWeights();
 	++m_injections;
 	return true;
 }

@@ -41,7 +41,8 @@ struct ParticleFilterOptions : public mrpt::config::CLoadableOptions
 	 * particle (3 DoF; 16.27 = 99.9%): a frame whose sightings all fail it
 	 * at the best particle is "unexplained". */
 	double gate_chi2 = 16.27;
-	/** Inject after this many consecutive unexplained frames (0 disables). */
+	/** Inject after this many consecutive unexplained frames once converged
+	 * (kidnapping); before the first convergence after one (0 disables). */
 	int inject_after_unexplained = 2;
 	double inject_min_std_xy_m = 0.02;  //!< floor of the injected spread (added to the fix's C) [m]
 	double inject_min_std_yaw_deg = 1.0;  //!< floor of the injected spread [deg]
