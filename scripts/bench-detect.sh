@@ -6,7 +6,8 @@
 # overwriting the committed one unless --out is given.
 #
 # Usage: scripts/bench-detect.sh [--quick] [--build-dir DIR] [other options of
-#        codemark-bench-detect, e.g. --positions N --clutter N]
+#        codemark-bench-detect, e.g. --positions N --clutter N,
+#        --dump-misses DIR to keep codemark's missed frames as PNG]
 # Environment: BUILD_DIR (default build-bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."

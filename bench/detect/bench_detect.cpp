@@ -17,6 +17,7 @@
 
 #include <opencv2/aruco.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 extern "C"
@@ -389,6 +390,7 @@ struct Config
 	uint64_t seed = 1;
 	std::string out;
 	std::string revision;  // source revision, printed in the report
+	std::string dump_dir;  // where codemark's missed sweep frames go (empty: nowhere)
 };
 
 int runBench(const Config& cfg)
@@ -547,6 +549,16 @@ int runBench(const Config& cfg)
 					s.times_us.push_back(us);
 					score(r, f.truth, s);
 					sweep[k][di][ai].add(s);
+					if (k == 0 && s.truths && !s.detected && !cfg.dump_dir.empty())
+					{
+						// The frame and its true corners, for the detector's engineer.
+						const std::string base = cfg.dump_dir + "/miss-" + fmt(distances[di], 2) + "m-" +
+							fmt(a * 180 / CV_PI, 0) + "deg-seed" + std::to_string(frame_seed);
+						cv::imwrite(base + ".png", f.bgr);
+						std::ofstream t(base + ".txt");
+						t << "# id " << f.truth[0].id << "; true reference corners TL TR BR BL [px], (0,0) = centre of the top-left pixel\n";
+						for (const auto& c : f.truth[0].corners_px) t << std::setprecision(10) << c.x() << " " << c.y() << "\n";
+					}
 					if (k == 0 && s.truths && !s.detected && misses.size() < 30)
 						misses.push_back(fmt(distances[di], 2) + " m, " + fmt(a * 180 / CV_PI, 0) + " deg, ref. square " +
 							fmt(f.truth[0].ref_height_px, 1) + " px high, centre (" +
@@ -897,7 +909,8 @@ int runBench(const Config& cfg)
 		}
 		md << (any ? "the subpixel stage (edge profiles, line fits) sets it.\n" : "met at every distance.\n");
 	}
-	md << "- codemark's missed sweep frames (up to 30 listed; " << all[0].truths - all[0].detected << " in all):"
+	md << "- codemark's missed sweep frames (up to 30 listed; " << all[0].truths - all[0].detected
+	   << " in all; `codemark-bench-detect --dump-misses DIR` writes them as PNG with their true corners):"
 	   << (misses.empty() ? " none" : "") << "\n";
 	for (const auto& m : misses) md << "  - " << m << "\n";
 
@@ -931,6 +944,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> clutter("", "clutter", "background-only frames (default 1000, quick 30)", false, -1, "N", cmd);
 		TCLAP::ValueArg<int> scale("", "scale-frames", "frames per image size / landmark count (default 10, quick 2)", false, 0, "N", cmd);
 		TCLAP::ValueArg<std::string> revision("", "revision", "source revision to print in the report", false, "", "TEXT", cmd);
+		TCLAP::ValueArg<std::string> dump("", "dump-misses", "write codemark's missed sweep frames (PNG + true corners) into this existing directory", false, "", "DIR", cmd);
 		cmd.parse(argc, argv);
 		Config cfg;
 		cfg.quick = quick.getValue();
@@ -945,6 +959,7 @@ int main(int argc, char** argv)
 		if (scale.getValue() > 0) cfg.scale_frames = scale.getValue();
 		cfg.out = out.getValue();
 		cfg.revision = revision.getValue();
+		cfg.dump_dir = dump.getValue();
 		return runBench(cfg);
 	}
 	catch (const TCLAP::ArgException& e)
