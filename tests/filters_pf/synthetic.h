@@ -50,18 +50,18 @@ inline Eigen::Matrix3d sightingCov(double l2_m)
 		.asDiagonal();
 }
 
-/** The sightings of \a map's landmarks in view (range 0.4..5 m, bearing
+/** The sightings (by a camera \a robot_T_camera) of \a map's landmarks in view (range 0.4..5 m, bearing
  * within +-25 deg, seen from the front within +-60 deg) from a robot at
  * \a world_T_robot; with noise drawn from C_L when \a rng is given. */
 inline CObservationCodedLandmarks::Ptr observe(
 	const mrpt::poses::CPose2D& world_T_robot, const LandmarkMap& map, std::mt19937* rng = nullptr,
-	double t = 0)
+	double t = 0, const mrpt::poses::CPose3D& robot_T_camera = robotTCamera())
 {
 	auto o = CObservationCodedLandmarks::Create();
 	o->sensorLabel = "CAM_LANDMARKS";
 	o->timestamp = mrpt::Clock::fromDouble(1700000000.0 + t);
-	o->cameraPose = robotTCamera();
-	const auto world_T_camera = pose::worldTCamera(world_T_robot, robotTCamera());
+	o->cameraPose = robot_T_camera;
+	const auto world_T_camera = pose::worldTCamera(world_T_robot, robot_T_camera);
 	std::normal_distribution<double> n01(0.0, 1.0);
 	for (const auto& lm : map.landmarks)
 	{
