@@ -191,7 +191,7 @@ Result repeat(int reps, F run)
 
 // Synthetic map of \a n coded landmarks on a ring facing its centre; the
 // robot drives a circle inside it with a forward camera and sees the
-// landmarks within 4 m and +-30 deg. One lap maps everything; the second
+// landmarks within 4 m and +-0.5 rad. One lap maps everything; the second
 // lap is timed.
 void scaling(int n, unsigned seed, double& step_ms, double& visible)
 {
@@ -210,9 +210,11 @@ void scaling(int n, unsigned seed, double& step_ms, double& visible)
 	init.initialized = true;
 	init.mean = mrpt::poses::CPose2D(start[0], start[1], start[2]);
 	EkfSlam slam(o, LandmarkMap{}, init);
-	// A level forward camera 0.2 m ahead of the robot centre; its planar pose.
-	const mrpt::poses::CPose3D cam_pose(0.2, 0, 0.5, -M_PI / 2, 0, -M_PI / 2);
-	const mrpt::poses::CPose2D cam2d(0.2, 0, 0);
+	// A level camera 0.2 m ahead of the robot centre looking 1 rad to the
+	// right, towards the ring (the robot drives counter-clockwise).
+	const mrpt::poses::CPose3D cam_pose = mrpt::poses::CPose3D(0.2, 0, 0.5, -1.0, 0, 0) +
+		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	const mrpt::poses::CPose2D cam2d(0.2, 0, -1.0);
 	const int per_lap = 400;
 	const double dth = 2 * M_PI / per_lap, ds = R_robot * dth;
 	Eigen::Vector3d robot = start;

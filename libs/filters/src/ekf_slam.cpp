@@ -809,6 +809,9 @@ EkfSlam::EkfSlam(
 			k.use_analytic_observation_jacobian, k.debug_verify_analytic_jacobians,
 			k.debug_verify_analytic_jacobians_threshold};
 	}
+	// With a prior map and no initial pose the robot waits for a pose fix
+	// (full landmarks; build() decides for good).
+	m.initialized = prior.landmarks.empty() || (initial && initial->initialized);
 	if (options.landmarks == SlamLandmarks::Full) m.build(m.k3);
 	else if (options.landmarks == SlamLandmarks::Point)
 		m.build(m.k2);
@@ -827,8 +830,9 @@ StepStats EkfSlam::step(
 	{
 		if (all.empty())
 		{
-			// Nothing to decide the landmark kind by: dead-reckon the pose.
-			if (odometry && odometry->poseChange)
+			// Nothing to decide the landmark kind by: dead-reckon the pose
+			// (unless it waits for a fix from a prior map).
+			if (m.initialized && odometry && odometry->poseChange)
 			{
 				const mrpt::poses::CPosePDFGaussian g(*odometry->poseChange);
 				PoseEstimate e = m.initial.value_or(PoseEstimate{});
@@ -862,7 +866,7 @@ PoseEstimate EkfSlam::estimate() const
 	if (!m.created())
 	{
 		PoseEstimate e = m.initial.value_or(PoseEstimate{});
-		e.initialized = true;
+		e.initialized = m.initialized;
 		return e;
 	}
 	return m.visit(
