@@ -218,22 +218,32 @@ std::optional<RefinedQuad> refineQuadrangle(
 		{
 			const int* gp = g_prof.data() + j * n;
 			const int* rbp = rb_prof.data() + j * n;
-			std::optional<double> e;
-			if (!side_saturated)
-				e = locateRisingEdge(gp, n, lo, hi, min_rise, p, mode);
-			else
-			{
+			// The edge must have the green fill just inside it (G above R + B
+			// two pixels inwards): the sheet's edge against a darker wall
+			// rises inwards too, a frame width and a margin outside.
+			const auto greenInside = [&](double e) {
+				const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
+				return gp[i] > -rbp[i];
+			};
+			const auto locate = [&](int l, int h) -> std::optional<double> {
+				if (!side_saturated) return locateRisingEdge(gp, n, l, h, min_rise, p, mode);
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.
-				const auto g_peak = locateRisingEdge(gp, n, lo, hi, min_rise, p, EdgeMode::Peak);
-				if (g_peak)
-				{
-					const int k = static_cast<int>(std::lround(*g_peak));
-					if (side_heavy && mode == EdgeMode::Centroid)
-						e = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
-					if (!e) e = g_peak;
-				}
+				const auto g_peak = locateRisingEdge(gp, n, l, h, min_rise, p, EdgeMode::Peak);
+				if (!g_peak) return std::nullopt;
+				std::optional<double> r;
+				const int k = static_cast<int>(std::lround(*g_peak));
+				if (side_heavy && mode == EdgeMode::Centroid)
+					r = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
+				return r ? r : g_peak;
+			};
+			std::optional<double> e = locate(lo, hi);
+			if (e && !greenInside(*e))
+			{
+				// Retry inwards of the rejected edge.
+				e = locate(static_cast<int>(std::lround(*e)) + 1, hi);
+				if (e && !greenInside(*e)) e.reset();
 			}
 			if (!e) continue;
 			const double c = origin[j] + inward * (*e - half);

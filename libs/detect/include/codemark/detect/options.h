@@ -173,7 +173,7 @@ struct CodeParams
 	/** Each side of the frame must stay below this fraction of the fill's G
 	 * next to it (looser: at 60 deg and 5 m a side is under 2 px wide and
 	 * blurs towards its neighbours). */
-	double max_side_black_ratio = 0.6;
+	double max_side_black_ratio = 0.75;
 	/** Each cell's distance to the threshold must be at least this fraction
 	 * of the contrast (else ambiguous: rejected). */
 	double min_margin = 0.15;
