@@ -113,7 +113,7 @@ void symmetriseAndCheckCovariance(
 		os << what << ": covariance has non-finite entries:\n" << P;
 		throw std::runtime_error(os.str());
 	}
-	P = 0.5 * (P + P.transpose());
+	P = (0.5 * (P + P.transpose())).eval();  // eval: P.transpose() aliases P
 	Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(P);
 	const Eigen::Vector3d ev = es.eigenvalues();  // ascending
 	if (ev[0] < -tolerance * std::max(1.0, ev[2]))
@@ -128,7 +128,7 @@ void symmetriseAndCheckCovariance(
 	{
 		const Eigen::Vector3d fixed = ev.cwiseMax(min_eigenvalue);
 		P = es.eigenvectors() * fixed.asDiagonal() * es.eigenvectors().transpose();
-		P = 0.5 * (P + P.transpose());
+		P = (0.5 * (P + P.transpose())).eval();
 	}
 }
 

@@ -13,6 +13,7 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/datetime.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -114,7 +115,8 @@ struct RawlogStepper::Impl
 	std::optional<Frame> open;  // frame still collecting observations
 	std::deque<Frame> pending;  // closed frames waiting for odometry
 	std::optional<std::pair<double, CPose2D>> last_odo;  // latest reading (t, pose)
-	std::optional<CPose2D> prev_frame_odo;  // interpolated odometry at the previous step
+	std::optional<std::pair<double, CPose2D>> seg_start;  // start (t, pose) of the current segment
+	bool had_frame_with_odometry = false;
 
 	std::deque<RawlogStep> ready;
 
@@ -200,28 +202,61 @@ struct RawlogStepper::Impl
 		emit(f, odo);
 	}
 
+	// Observations-only: the motion model applies to each odometry interval
+	// (reading to reading, as a robot's odometry accumulates its noise); a
+	// part of an interval, cut at an image time, gets the model of its
+	// increment with the covariance scaled by its share of the interval's
+	// duration. The segments since the previous image are composed.
+	void addSegment(const CPose2D& from, const CPose2D& to, double fraction)
+	{
+		mrpt::obs::CActionRobotMovement2D act;
+		act.computeFromOdometry(to - from, opt.motion);
+		mrpt::poses::CPosePDFGaussian g;
+		g.copyFrom(*act.poseChange);
+		g.cov *= std::clamp(fraction, 0.0, 1.0);
+		if (!acc) acc = g;
+		else *acc += g;
+	}
+
 	void onObservation(const CObservation::Ptr& o, long entry)
 	{
 		if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(o))
 		{
 			closeOpen();
 			const double t = mrpt::Clock::toDouble(odo->timestamp);
+			const double interval = last_odo ? t - last_odo->first : 0.0;
 			// Every pending frame up to this reading's time gets the odometry
 			// interpolated between the previous reading and this one.
 			while (!pending.empty() && mrpt::Clock::toDouble(pending.front().stamp) <= t)
 			{
 				const double tf = mrpt::Clock::toDouble(pending.front().stamp);
-				const CPose2D p = last_odo
-					? interpolatePose(last_odo->first, last_odo->second, t, odo->odometry, tf)
-					: odo->odometry;
-				emitWithOdometry(pending.front(), p);
+				if (!last_odo)
+				{
+					emit(pending.front(), nullptr);  // before any odometry
+					pending.pop_front();
+					continue;
+				}
+				const CPose2D p = interpolatePose(last_odo->first, last_odo->second, t, odo->odometry, tf);
+				addSegment(seg_start->second, p, interval > 0 ? (tf - seg_start->first) / interval : 1.0);
+				seg_start = {tf, p};
+				emitAccumulated(pending.front());
 				pending.pop_front();
 			}
+			if (last_odo)
+				addSegment(seg_start->second, odo->odometry,
+					interval > 0 ? (t - seg_start->first) / interval : 1.0);
 			last_odo = {t, odo->odometry};
+			seg_start = last_odo;
 			return;
 		}
 		if (!isCameraFrameObservation(*o)) return;
-		if (open && open->stamp != o->timestamp) closeOpen();
+		// A frame: consecutive camera observations with one timestamp, one per
+		// sensor label (so that rawlogs without timestamps still split).
+		if (open &&
+			(open->stamp != o->timestamp ||
+				std::any_of(open->obs.begin(), open->obs.end(),
+					[&](const CObservation::Ptr& x) { return x->sensorLabel == o->sensorLabel; })))
+			closeOpen();
 		if (!open)
 		{
 			open = Frame();
@@ -239,17 +274,15 @@ struct RawlogStepper::Impl
 		open.reset();
 	}
 
-	// Observations-only: the frame with the robot's odometry pose at its time.
-	void emitWithOdometry(const Frame& f, const CPose2D& odo_pose)
+	// Observations-only: the frame with the motion accumulated since the
+	// previous frame (null for the first frame after odometry started).
+	void emitAccumulated(const Frame& f)
 	{
 		mrpt::obs::CActionRobotMovement2D::Ptr act;
-		if (prev_frame_odo)
-		{
-			act = mrpt::obs::CActionRobotMovement2D::Create();
-			act->computeFromOdometry(odo_pose - *prev_frame_odo, opt.motion);
-			act->timestamp = f.stamp;
-		}
-		prev_frame_odo = odo_pose;
+		if (acc && had_frame_with_odometry) act = actionFromPdf(*acc);
+		if (act) act->timestamp = f.stamp;
+		acc.reset();
+		had_frame_with_odometry = true;
 		emit(f, act);
 	}
 
@@ -260,7 +293,7 @@ struct RawlogStepper::Impl
 		{
 			// After the last reading: no later one to interpolate with; the
 			// last reading is the best known odometry (no extrapolation).
-			if (last_odo) emitWithOdometry(pending.front(), last_odo->second);
+			if (last_odo) emitAccumulated(pending.front());
 			else emit(pending.front(), nullptr);
 			pending.pop_front();
 		}

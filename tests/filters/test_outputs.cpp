@@ -1,0 +1,176 @@
+// Ground-truth files, metrics and the whole codemark-localize run on a
+// synthetic rawlog of landmark observations (no images).
+#include <codemark/filters/ground_truth.h>
+#include <codemark/filters/outputs.h>
+#include <gtest/gtest.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/serialization/CArchive.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "common.h"
+
+using namespace codemark;
+using namespace codemark::filters;
+using namespace codemark::filters::test;
+using mrpt::poses::CPose2D;
+namespace fs = std::filesystem;
+
+namespace
+{
+fs::path tempDir()
+{
+	const auto dir = fs::temp_directory_path() / ("codemark_test_outputs_" + std::to_string(getpid()));
+	fs::create_directories(dir);
+	return dir;
+}
+
+std::string writeText(const std::string& name, const std::string& text)
+{
+	const auto p = (tempDir() / name).string();
+	std::ofstream(p) << text;
+	return p;
+}
+}  // namespace
+
+TEST(GroundTruth, TimestampedRowsMatchByTimestamp)
+{
+	const auto gt = GroundTruth::load(
+		writeText("gt.txt", "# t x y yaw\n100.000000 1 2 0.5\n100.200000 1.1 2 0.6\n"));
+	EXPECT_EQ(gt.form(), GroundTruth::Form::Timestamped);
+	ASSERT_TRUE(gt.poseAt(7, 100.2000004));
+	EXPECT_DOUBLE_EQ(gt.poseAt(7, 100.2000004)->x(), 1.1);
+	EXPECT_FALSE(gt.poseAt(0, 100.1));
+}
+
+TEST(GroundTruth, MrptPathStepIMatchesRowIPlusOne)
+{
+	const auto gt = GroundTruth::load(
+		writeText("path.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
+	EXPECT_EQ(gt.form(), GroundTruth::Form::MrptPath);
+	ASSERT_TRUE(gt.poseAt(0, 12345.0));
+	EXPECT_DOUBLE_EQ(gt.poseAt(0, 0)->x(), 1.0);
+	EXPECT_NEAR(gt.poseAt(1, 0)->phi(), 0.2, 1e-12);
+	EXPECT_FALSE(gt.poseAt(2, 0));
+}
+
+TEST(GroundTruth, BadRowsNameFileAndLine)
+{
+	try
+	{
+		GroundTruth::load(writeText("bad.txt", "1 2 3 4\n1 2 x 4\n"));
+		FAIL();
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("bad.txt:2"), std::string::npos) << e.what();
+	}
+	EXPECT_THROW(GroundTruth::load(writeText("cols.txt", "1 2 3\n")), std::runtime_error);
+	EXPECT_THROW(GroundTruth::load(writeText("mixed.txt", "1 2 3 4\n1 2 3 4 5 6\n")), std::runtime_error);
+}
+
+TEST(Metrics, KnownErrors)
+{
+	std::vector<PathRow> rows(2);
+	for (auto& r : rows)
+	{
+		r.estimate.initialized = true;
+		r.estimate.cov = Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal();
+	}
+	rows[0].estimate.mean = CPose2D(0.3, 0.4, 0.1);
+	rows[0].truth = CPose2D(0, 0, 0);
+	rows[1].estimate.mean = CPose2D(1, 1, M_PI - 0.05);
+	rows[1].truth = CPose2D(1, 1, -M_PI + 0.05);  // 0.1 rad across the cut
+	const auto m = computeMetrics(rows);
+	ASSERT_TRUE(m);
+	EXPECT_EQ(m->matched, 2);
+	EXPECT_NEAR(m->ate_rmse_m, std::sqrt(0.25 / 2), 1e-12);
+	EXPECT_NEAR(m->max_error_m, 0.5, 1e-12);
+	EXPECT_NEAR(m->yaw_rmse_deg, 0.1 * 180 / M_PI, 1e-9);
+	EXPECT_NEAR(m->nees_mean, ((0.25 + 0.01) / 0.01 + 0.01 / 0.01) / 2, 1e-9);
+	EXPECT_LT(m->nees_band_low, 3.0);
+	EXPECT_GT(m->nees_band_high, 3.0);
+}
+
+TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
+{
+	// A robot turning on a circle in the test room, actions-observations
+	// format, sightings of the landmarks it faces.
+	const LandmarkMap map = roomMap();
+	const auto dir = tempDir() / "run";
+	fs::create_directories(dir);
+	map.save((dir / "map.txt").string());
+	const std::string rawlog = (dir / "in.rawlog").string();
+	std::ofstream gt(dir / "gt.txt");
+	gt << std::fixed;
+	std::mt19937 rng(5);
+	{
+		mrpt::io::CFileGZOutputStream f(rawlog);
+		auto ar = mrpt::serialization::archiveFrom(f);
+		const auto cam = cameraOnRobot();
+		// A circle of radius 1 m about (3, 2.1): truth_k = truth_{k-1} (+) u.
+		const CPose2D u(0.05, 0, 0.05);
+		CPose2D truth(3, 1.1, 0);
+		for (int k = 0; k < 120; ++k)
+		{
+			if (k > 0) truth = truth + u;
+			mrpt::obs::CActionCollection acts;
+			acts.insert(odometry(k ? u : CPose2D(), 0.002, 0.002));
+			ar << acts;
+			std::vector<CObservationCodedLandmarks::TSighting> s;
+			for (const auto& l : map.landmarks)
+			{
+				const auto sg = sighting(truth, cam, l, Eigen::Vector3d(0.01, 0.002, 0.01), &rng);
+				if (std::abs(sg.L[1]) < 0.4 && std::abs(sg.L[2]) < 1.0) s.push_back(sg);
+			}
+			auto sf = frameOf(s);
+			const double t = 1700000000.0 + 0.2 * k;
+			for (auto& o : sf) o->timestamp = mrpt::Clock::fromDouble(t);
+			ar << sf;
+			gt << std::setprecision(6) << t << ' ' << truth.x() << ' ' << truth.y() << ' ' << truth.phi() << '\n';
+		}
+	}
+	gt.close();
+	LocalizeRequest req;
+	req.config_file = writeText("ekf.ini", "[localize]\nmethod = ekf\n[ekf]\ngate_probability = 0.999\n");
+	req.rawlog = rawlog;
+	req.map_file = (dir / "map.txt").string();
+	req.gt_file = (dir / "gt.txt").string();
+	req.out_dir = (dir / "out").string();
+	const auto s = runLocalization(req);
+	EXPECT_EQ(s.method, "ekf");
+	EXPECT_EQ(s.steps, 120);
+	EXPECT_GT(s.sightings_used, 100);
+	ASSERT_TRUE(s.metrics);
+	EXPECT_LT(s.metrics->ate_rmse_m, 0.02);
+	for (const char* f : {"estimated_path.txt", "estimated_path.tum", "covariances.txt", "trajectory.png",
+			 "trajectory.3Dscene", "summary.json"})
+		EXPECT_TRUE(fs::exists(fs::path(req.out_dir) / f)) << f;
+	std::ifstream path(fs::path(req.out_dir) / "estimated_path.txt");
+	std::string line;
+	std::getline(path, line);
+	std::getline(path, line);
+	double t, x, y, yaw;
+	ASSERT_TRUE(std::istringstream(line) >> t >> x >> y >> yaw);
+	EXPECT_NE(line.find(".000000 "), std::string::npos) << line;  // >= 6 decimals
+	std::ifstream js(fs::path(req.out_dir) / "summary.json");
+	const std::string json((std::istreambuf_iterator<char>(js)), {});
+	for (const char* k : {"\"steps\"", "\"sightings_used\"", "\"sightings_rejected\"", "\"sightings_unknown_id\"",
+			 "\"time_per_step_ms\"", "\"ate_rmse_m\"", "\"max_error_m\"", "\"yaw_rmse_deg\"", "\"nees_mean\""})
+		EXPECT_NE(json.find(k), std::string::npos) << k;
+
+	// Bad input: one error naming the file.
+	req.map_file = writeText("badmap.txt", "1 2 3\n");
+	try
+	{
+		runLocalization(req);
+		FAIL();
+	}
+	catch (const std::exception& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("badmap.txt"), std::string::npos) << e.what();
+	}
+}

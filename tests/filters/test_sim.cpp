@@ -1,0 +1,60 @@
+// The EKF on simulated datasets with rendered images (sim::writeDataset),
+// detected on the fly: a room loop with 5 Hz images and a 3% odometry scale
+// error, both rawlog formats, with the shipped share/codemark/config/ekf.ini.
+#include <codemark/filters/outputs.h>
+#include <codemark/sim/dataset.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+namespace fs = std::filesystem;
+using namespace codemark;
+using namespace codemark::filters;
+
+namespace
+{
+LocalizeSummary runOn(bool obs_only, int max_frames, const std::string& method, const std::string& ini)
+{
+	sim::DatasetOptions o;
+	o.odometry_scale_error = 0.03;
+	o.seed = 3;
+	const auto dir = fs::temp_directory_path() /
+		("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao"));
+	if (!fs::exists(dir / "dataset.rawlog")) sim::writeDataset(o, dir.string(), obs_only, {}, max_frames);
+	LocalizeRequest req;
+	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/" + ini;
+	req.rawlog = (dir / "dataset.rawlog").string();
+	req.map_file = (dir / "map.txt").string();
+	req.gt_file = (dir / "gt_path.txt").string();
+	req.method = method;
+	return runLocalization(req);
+}
+
+void expectConsistent(const LocalizeSummary& s, double max_ate_m)
+{
+	ASSERT_TRUE(s.metrics);
+	const auto& m = *s.metrics;
+	EXPECT_EQ(s.first_fix_step, 0);  // first fix at the first sighting (landmarks in view at the start)
+	EXPECT_EQ(m.matched, s.steps);
+	EXPECT_LE(m.ate_rmse_m, max_ate_m);
+	EXPECT_GT(m.nees_mean, m.nees_band_low) << "mean NEES below the 95% band: too pessimistic";
+	EXPECT_LT(m.nees_mean, m.nees_band_high) << "mean NEES above the 95% band: overconfident";
+	EXPECT_GT(s.sightings_used, s.steps / 2);
+	std::cout << s.method << ": " << s.steps << " steps, ATE " << m.ate_rmse_m << " m, max " << m.max_error_m
+			  << " m, yaw RMSE " << m.yaw_rmse_deg << " deg, NEES " << m.nees_mean << " in [" << m.nees_band_low
+			  << ", " << m.nees_band_high << "], used " << s.sightings_used << ", rejected "
+			  << s.sightings_rejected << "\n";
+}
+}  // namespace
+
+TEST(FiltersSim, EkfAndEkfPoseFullLoopActionsObservations)
+{
+	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.03);
+	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.03);
+}
+
+TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
+{
+	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.03);
+}
