@@ -95,6 +95,12 @@ int main(int argc, char** argv)
 			bo.background = sim::Background::Cluttered;
 			bo.distractors = 12;
 			const cv::Mat bg_img = sim::render(bg_scene, bo, 99).image;
+			{
+				const auto b = detect::detect(bg_img, sc.camera, LandmarkGeometry(), opt);
+				printf("background counts comp %d rois %d quads %d fitted %d | seg %.0f comp %.0f edg %.0f sub %.0f code %.0f total %.0f us\n",
+					b.counts.components, b.counts.rois, b.counts.quads, b.counts.fitted, b.timings.segmentation_us,
+					b.timings.components_us, b.timings.edgels_us, b.timings.subpixel_us, b.timings.code_us, b.timings.total_us);
+			}
 			const auto a1 = timeIt([&] { cv::aruco::detectMarkers(r.image, dict, corners, ids, params); }, 30);
 			const auto c1 = timeIt([&] { detect::detect(r.image, sc.camera, LandmarkGeometry(), opt); }, 300);
 			const auto a0 = timeIt([&] { cv::aruco::detectMarkers(bg_img, dict, corners, ids, params); }, 30);

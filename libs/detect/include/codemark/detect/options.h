@@ -89,7 +89,7 @@ struct EdgelParams
 	 * that brings them under it before the gradients (near landmarks: this
 	 * stage needs the sides to a pixel, the sub-pixel stage works at full
 	 * resolution). */
-	double max_roi_px = 128;
+	double max_roi_px = 96;
 };
 
 /** Stage 5: selection of the four inner frame edges among the domains. */
