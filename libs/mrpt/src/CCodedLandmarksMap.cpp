@@ -27,12 +27,57 @@ namespace
 constexpr double kTwoPi = 2.0 * M_PI;
 constexpr int kMaxIndexedId = 65536;
 
-/** log((1 - p) exp(log_gauss) + p exp(log_uniform)), computed stably. */
+/** Wraps an angle in (-3 pi, 3 pi), e.g. a difference of two wrapped
+ * angles, to (-pi, pi] without fmod (hot path: once per particle). */
+inline double wrapNear(double a)
+{
+	if (a > M_PI) return a - kTwoPi;
+	if (a <= -M_PI) return a + kTwoPi;
+	return a;
+}
+
+/** A difference of angles wrapped to (-pi, pi]: the cheap branch for
+ * wrapped inputs, MRPT's general one otherwise. */
+inline double wrapDiff(double a)
+{
+	a = wrapNear(a);
+	return (a > M_PI || a <= -M_PI) ? mrpt::math::wrapToPi(a) : a;
+}
+
+/** The camera's pose in frame L (\a xl, \a yl [m], heading (\a ux, \a uy))
+ * of a camera at (cam_x, cam_y, heading (cam_cos, cam_sin)) in the world and
+ * a landmark at (lm_x, lm_y, yaw (lm_cos, lm_sin)): a rotation by -yaw. */
+struct InLandmark
+{
+	double xl, yl, ux, uy;
+	InLandmark(double cam_x, double cam_y, double cam_cos, double cam_sin, double lm_x, double lm_y,
+		double lm_cos, double lm_sin)
+	{
+		const double dx = cam_x - lm_x, dy = cam_y - lm_y;
+		xl = lm_cos * dx + lm_sin * dy;
+		yl = -lm_sin * dx + lm_cos * dy;
+		ux = lm_cos * cam_cos + lm_sin * cam_sin;
+		uy = -lm_sin * cam_cos + lm_cos * cam_sin;
+	}
+	/** L = [l2 phi1 phi2]: theta = pi + phi2 and atan2(y, x) = phi1 + phi2
+	 * (spec section 4). */
+	Eigen::Vector3d L() const
+	{
+		const double phi2 = std::atan2(-uy, -ux);
+		return {std::hypot(xl, yl), wrapNear(std::atan2(yl, xl) - phi2), phi2};
+	}
+};
+
+/** log((1 - p) exp(log_gauss) + p exp(log_uniform)), computed stably; when
+ * one term exceeds the other by e^35 the smaller one is below double
+ * precision of the sum and is skipped (no exp/log on the hot path). */
 double logMixture(double log_gauss, double log_uniform, double p)
 {
 	if (p <= 0) return log_gauss;
 	const double a = std::log1p(-p) + log_gauss;
 	const double b = std::log(p) + log_uniform;
+	if (a - b > 35) return a;
+	if (b - a > 35) return b;
 	const double m = std::max(a, b);
 	return m + std::log(std::exp(a - m) + std::exp(b - m));
 }
@@ -178,25 +223,16 @@ Eigen::Vector3d CCodedLandmarksMap::predictL(
 	double cam_x, double cam_y, double cam_cos, double cam_sin, double lm_x, double lm_y,
 	double lm_cos, double lm_sin)
 {
-	// The camera's position and heading in frame L (rotation by -yaw).
-	const double dx = cam_x - lm_x, dy = cam_y - lm_y;
-	const double xl = lm_cos * dx + lm_sin * dy;
-	const double yl = -lm_sin * dx + lm_cos * dy;
-	const double ux = lm_cos * cam_cos + lm_sin * cam_sin;
-	const double uy = -lm_sin * cam_cos + lm_cos * cam_sin;
-	// theta = pi + phi2 and atan2(y, x) = phi1 + phi2 (spec section 4).
-	const double phi2 = std::atan2(-uy, -ux);
-	const double phi1 = mrpt::math::wrapToPi(std::atan2(yl, xl) - phi2);
-	return {std::hypot(xl, yl), phi1, phi2};
+	return InLandmark(cam_x, cam_y, cam_cos, cam_sin, lm_x, lm_y, lm_cos, lm_sin).L();
 }
 
 double CCodedLandmarksMap::sightingLogLikelihood(
 	const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, double cam_x, double cam_y,
 	double cam_cos, double cam_sin, const MapLandmark& lm) const
 {
-	const double c = std::cos(lm.yaw_rad), s = std::sin(lm.yaw_rad);
-	const Eigen::Vector3d Lp = predictL(cam_x, cam_y, cam_cos, cam_sin, lm.x_m, lm.y_m, c, s);
-	return scoreL(L, C_L, Lp);
+	const InLandmark in(
+		cam_x, cam_y, cam_cos, cam_sin, lm.x_m, lm.y_m, std::cos(lm.yaw_rad), std::sin(lm.yaw_rad));
+	return scoreL(L, C_L, in.xl, in.yl, in.ux, in.uy);
 }
 
 bool CCodedLandmarksMap::cameraInWorld(
@@ -231,25 +267,35 @@ double CCodedLandmarksMap::sightingMahalanobis2(
 	const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, const Eigen::Vector3d& Lp) const
 {
 	Eigen::Vector3d r = L - Lp;
-	r[1] = mrpt::math::wrapToPi(r[1]);
-	r[2] = mrpt::math::wrapToPi(r[2]);
+	r[1] = wrapDiff(r[1]);
+	r[2] = wrapDiff(r[2]);
 	const Eigen::Matrix3d C = inflatedCovariance(C_L);
 	if (!(C.determinant() > 0)) return std::numeric_limits<double>::infinity();
 	return r.dot(C.inverse() * r);
 }
 
 double CCodedLandmarksMap::scoreL(
-	const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, const Eigen::Vector3d& Lp) const
+	const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, double xl, double yl, double ux,
+	double uy) const
 {
 	const auto& o = likelihoodOptions;
-	Eigen::Vector3d r = L - Lp;
-	r[1] = mrpt::math::wrapToPi(r[1]);
-	r[2] = mrpt::math::wrapToPi(r[2]);
-	const Eigen::Matrix3d C = inflatedCovariance(C_L);
+	const double p = o.outlier_probability;
 	const double log_uniform = -std::log(o.max_range_m * kTwoPi * kTwoPi);
-	double lg = 0;
-	if (!logGauss<3>(r, C, lg)) return log_uniform;	 // unusable covariance: no information
-	return logMixture(lg, log_uniform, o.outlier_probability);
+	const Eigen::Matrix3d C = inflatedCovariance(C_L);
+	const double det = C.determinant();
+	if (!(det > 0) || !std::isfinite(det)) return log_uniform;  // unusable covariance: no information
+	const double log_norm = -0.5 * (3 * std::log(kTwoPi) + std::log(det));
+	// Early out before the angles: d^2 >= r_range^2 / C(0,0) for any
+	// positive definite C, so a range residual alone can make the Gaussian
+	// term negligible against the uniform (e^-35).
+	const double r0 = L[0] - std::hypot(xl, yl);
+	const double log_out = p > 0 ? std::log(p) + log_uniform : 0;
+	if (p > 0 && std::log1p(-p) + log_norm - 0.5 * r0 * r0 / C(0, 0) - log_out < -35) return log_out;
+	const double phi2 = std::atan2(-uy, -ux);
+	const double phi1 = wrapNear(std::atan2(yl, xl) - phi2);
+	const Eigen::Vector3d r(r0, wrapDiff(L[1] - phi1), wrapDiff(L[2] - phi2));
+	const double lg = log_norm - 0.5 * r.dot(C.inverse() * r);
+	return logMixture(lg, log_uniform, p);
 }
 
 double CCodedLandmarksMap::internal_computeObservationLikelihood(
@@ -261,9 +307,13 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 	const auto& R = takenFrom.getRotationMatrix();
 	const double rc = R(0, 0), rs = R(1, 0), rx = takenFrom.x(), ry = takenFrom.y();
 
-	if (const auto* coded = dynamic_cast<const CObservationCodedLandmarks*>(&obs))
+	// Exact class checks (pointer compares) rather than dynamic_cast: this
+	// runs once per particle and observation.
+	const auto* cls = obs.GetRuntimeClass();
+	if (cls == CLASS_ID(CObservationCodedLandmarks))
 	{
 		double cam_x = 0, cam_y = 0, cam_c = 1, cam_s = 0;
+		const auto* coded = static_cast<const CObservationCodedLandmarks*>(&obs);
 		if (!cameraInWorld(rx, ry, rc, rs, coded->cameraPose, cam_x, cam_y, cam_c, cam_s))
 			return 0;  // camera looking straight up/down: no planar model
 		double ll = 0;
@@ -272,15 +322,15 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 			const int i = indexOf(sg.id);
 			if (i < 0) continue;  // unknown ID: no information about the pose
 			const Cached& lm = m_cache[static_cast<size_t>(i)];
-			const Eigen::Vector3d Lp =
-				predictL(cam_x, cam_y, cam_c, cam_s, lm.x, lm.y, lm.cos_yaw, lm.sin_yaw);
-			ll += scoreL(sg.L, sg.C_L, Lp);
+			const InLandmark in(cam_x, cam_y, cam_c, cam_s, lm.x, lm.y, lm.cos_yaw, lm.sin_yaw);
+			ll += scoreL(sg.L, sg.C_L, in.xl, in.yl, in.ux, in.uy);
 		}
 		return ll;
 	}
 
-	if (const auto* br = dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&obs))
+	if (cls == CLASS_ID(mrpt::obs::CObservationBearingRange))
 	{
+		const auto* br = static_cast<const mrpt::obs::CObservationBearingRange*>(&obs);
 		const mrpt::poses::CPose3D sensor = takenFrom + br->sensorLocationOnRobot;
 		const double k2 = o.sigma_scale * o.sigma_scale;
 		const double sa = o.min_std_angle_deg * M_PI / 180.0;
@@ -309,7 +359,7 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 			C(0, 0) += sr * sr;
 			C(1, 1) += sa * sa;
 			const Eigen::Vector3d r(
-				m.range - range, mrpt::math::wrapToPi(m.yaw - yaw), mrpt::math::wrapToPi(m.pitch - pitch));
+				m.range - range, wrapDiff(m.yaw - yaw), wrapDiff(m.pitch - pitch));
 			double lg = 0;
 			bool ok = false;
 			double log_uniform = -std::log(span * kTwoPi);
@@ -332,8 +382,9 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 bool CCodedLandmarksMap::internal_canComputeObservationLikelihood(
 	const mrpt::obs::CObservation& obs) const
 {
-	return dynamic_cast<const CObservationCodedLandmarks*>(&obs) != nullptr ||
-		dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&obs) != nullptr;
+	const auto* cls = obs.GetRuntimeClass();
+	return cls == CLASS_ID(CObservationCodedLandmarks) ||
+		cls == CLASS_ID(mrpt::obs::CObservationBearingRange);
 }
 
 // --------------------------------------------------------- serialization

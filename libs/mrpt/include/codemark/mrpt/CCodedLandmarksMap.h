@@ -152,8 +152,11 @@ class CCodedLandmarksMap : public mrpt::maps::CMetricMap
 	std::vector<int32_t> m_index;  //!< id -> index in m_map, -1 when absent (ids < 65536)
 	void rebuildIndex();
 	/** The mixture log-likelihood of a measured \a L (covariance \a C_L,
-	 * inflated by the options) against the predicted \a Lp. */
-	double scoreL(const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, const Eigen::Vector3d& Lp) const;
+	 * inflated by the options) for a camera at (\a xl, \a yl [m], heading
+	 * (\a ux, \a uy)) in the landmark's frame. */
+	double scoreL(
+		const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, double xl, double yl, double ux,
+		double uy) const;
 	int indexOf(int id) const;
 };
 
