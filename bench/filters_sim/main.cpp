@@ -179,6 +179,7 @@ int main(int argc, char** argv)
 				o.render.blur_sigma_px = nz.blur_sigma_px;
 				const auto dir = fs::path(work.getValue()) / ("seed" + std::to_string(seed) + "_noise" + std::to_string(int(nz.noise_sigma)));
 				std::fprintf(stderr, "filters_sim: dataset %s\n", dir.c_str());
+				fs::create_directories(dir);
 				const auto ds = sim::writeDataset(o, dir.string(), false, {}, frames.getValue());
 				std::vector<RawlogStep> steps;
 				for (const auto& m : ms)
