@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Builds and runs the particle-filter benchmark (bench/filters_pf): time per
+# update against the number of particles (10^2..10^5) with our
+# CCodedLandmarksMap and with a constant-likelihood map in the same run (the
+# ratio is issue 6's "at most 1.5x MRPT's own overhead" target), and frames
+# with sightings to convergence from a uniform start (shipped pf.ini, 10
+# seeds). Prints the markdown tables; docs/benchmarks/filters-pf.md quotes
+# them. About 1 minute on 2 cores.
+#
+# Usage: scripts/bench-filters-pf.sh [--quick] [--build-dir DIR]
+# Environment: BUILD_DIR (default build-bench).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir="${BUILD_DIR:-build-bench}"
+args=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --build-dir) build_dir="$2"; shift 2 ;;
+    *) args+=("$1"); shift ;;
+  esac
+done
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCODEMARK_BUILD_BENCH=ON >/dev/null
+cmake --build "$build_dir" -j"$(nproc)" --target codemark-bench-filters-pf
+echo "# codemark particle-filter benchmark ($(date -u +%Y-%m-%d), $(nproc) cores, commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))"
+echo
+"$build_dir/bench/filters_pf/codemark-bench-filters-pf" "${args[@]+"${args[@]}"}"
