@@ -46,6 +46,24 @@ section_sim()
 		"$BUILD_DIR/bench/filters_sim/filters_sim" --work "$WORK/sim" --seeds "$SEEDS" \
 			--max-frames "$MAX_FRAMES" --share "$ROOT/share/codemark"
 		echo
+		cat <<'NOTES'
+Notes on the simulated section:
+- The shipped ekf.ini / ekf-pose.ini set `[pose] sigma_px = 0.14`, calibrated
+  on the default renders (image noise 2, blur 0.8 px). With noisier images
+  (noise 6, blur 1.2 px) the detector's corners are worse than that sigma says:
+  the EKFs become overconfident (mean NEES well above 3) and a few bad
+  sightings pull the estimate away (large max error); raise `sigma_px` (or
+  `[ekf] measurement_cov_scale`) for such images.
+- The issue's target of ATE <= 3 cm is met on average on the default renders
+  only marginally (about 3.3 cm here): codemark-simul's default odometry noise
+  is MRPT's Gaussian model default (1 cm standard deviation per 8 cm step),
+  on top of the 3% scale error.
+- "first fix" is the time from the first frame to the first estimate; the
+  EKFs fix at the first frame in which a mapped landmark is detected.
+- Rows of other filters (ekf-slam, pf) use their inis as they were at the time
+  of the run.
+NOTES
+		echo
 	} >>"$DOC"
 }
 

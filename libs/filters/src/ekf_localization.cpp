@@ -13,6 +13,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -221,10 +222,21 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		if (!initialized_)
 		{
 			if (sightings.empty()) return st;
-			initialiseFrom(sightings.front());
+			// Initialise from the frame's most precise fix (smallest
+			// position covariance), then fuse the others.
+			auto best = sightings.begin();
+			double best_trace = std::numeric_limits<double>::infinity();
+			for (auto it = sightings.begin(); it != sightings.end(); ++it)
+			{
+				Eigen::Matrix3d C;
+				poseFix(*it, C);
+				const double tr = C.block<2, 2>(0, 0).trace();
+				if (tr < best_trace) best_trace = tr, best = it;
+			}
+			initialiseFrom(*best);
 			st.reinitialized = true;
 			++st.used;
-			sightings.erase(sightings.begin());
+			sightings.erase(best);
 		}
 
 		if (sightings.empty())
