@@ -11,6 +11,7 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -93,6 +94,10 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 	ASSERT_EQ(objs.size(), 160u);
 	const auto cam_on_robot = sim::DatasetOptions().cameraPoseOnRobot();
 	int checked = 0, within = 0;
+	// Normalised errors (error / reported sigma) of l2, phi1, phi2, near
+	// (< 2 m) and far: their mean is the bias, their RMS should be 1.
+	double sum[2][3] = {}, sum2[2][3] = {};
+	int count[2] = {};
 	for (int k = 0; k < 80; ++k)
 	{
 		auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(objs[2 * k + 1]);
@@ -117,8 +122,26 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 			const double sigma = std::sqrt(sg.C_L(0, 0));
 			within += std::abs(sg.L[0] - truth.L[0]) <= 3 * sigma;
 			++checked;
+			const int far = truth.L[0] >= 2.0;
+			++count[far];
+			for (int i = 0; i < 3; ++i)
+			{
+				const double e = i == 0 ? sg.L[0] - truth.L[0] : wrapToPi(sg.L[i] - truth.L[i]);
+				const double z = e / std::sqrt(sg.C_L(i, i));
+				sum[far][i] += z;
+				sum2[far][i] += z * z;
+			}
 		}
 	}
+	for (int far = 0; far < 2; ++far)
+		if (count[far])
+			std::printf(
+				"%s: %d sightings; error/sigma mean (bias) and RMS: l2 %+.2f %.2f, phi1 %+.2f %.2f, "
+				"phi2 %+.2f %.2f\n",
+				far ? ">= 2 m" : "< 2 m", count[far], sum[far][0] / count[far],
+				std::sqrt(sum2[far][0] / count[far]), sum[far][1] / count[far],
+				std::sqrt(sum2[far][1] / count[far]), sum[far][2] / count[far],
+				std::sqrt(sum2[far][2] / count[far]));
 	EXPECT_GE(checked, 40);
 	EXPECT_GE(within, 0.95 * checked) << within << " of " << checked << " ranges within 3 sigma";
 }

@@ -68,6 +68,15 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * (C_P = diag(s^2, s^2, s^2, s^2)). Each corner coordinate then has
 	 * sqrt(2) * sigma_px, which the general path uses. */
 	double sigma_px = kDefaultSigmaPx;
+	/** Standard deviation of y1 and y2 (the half-lengths of the vertical
+	 * edges) [px] when it differs from that of x1 and x2: then C_P =
+	 * diag(sigma_px^2, sigma_y_px^2, sigma_px^2, sigma_y_px^2) (spec section
+	 * 4 allows sx != sy). 0: the same as sigma_px. x1, x2 come from whole-edge
+	 * line fits; y1, y2 from where the top and bottom lines cut them, which
+	 * the detector locates less well. */
+	double sigma_y_px = 0;
+	/** sigma_y_px, or sigma_px when it is 0. */
+	double sigmaY() const { return sigma_y_px > 0 ? sigma_y_px : sigma_px; }
 	/** ini key `sigma_source` = Fixed | Detector (the latter only through
 	 * measure(const Detection&, ...)). */
 	SigmaSource sigma_source = SigmaSource::Fixed;
