@@ -5,6 +5,8 @@
  */
 #include <codemark/detect/detector.h>
 #include <codemark/detect/json.h>
+#include <codemark/pipeline/pipeline.h>
+#include <codemark/pose/measurement.h>
 #include <codemark/landmark/camera.h>
 #include <mrpt/config/CConfigFile.h>
 
@@ -52,11 +54,25 @@ std::string flatName(const std::string& s)
 	return out.empty() ? "image" : out;
 }
 
+std::string jsonVector(const Eigen::Vector3d& v)
+{
+	return "[" + detect::jsonNumber(v[0]) + ", " + detect::jsonNumber(v[1]) + ", " +
+		detect::jsonNumber(v[2]) + "]";
+}
+
+std::string jsonMatrix(const Eigen::Matrix3d& m)
+{
+	return "[" + jsonVector(m.row(0).transpose()) + ", " + jsonVector(m.row(1).transpose()) + ", " +
+		jsonVector(m.row(2).transpose()) + "]";
+}
+
 struct Runner
 {
 	CameraModel camera;
 	LandmarkGeometry geometry;
 	detect::DetectorOptions options;
+	/** Pose options: the pipeline's, calibrated for this detector. */
+	pose::PoseOptions pose = pipeline::detectorCalibratedPoseOptions();
 	std::string draw_dir, debug_dir;
 	bool warned_size = false;
 	int failures = 0;
@@ -87,7 +103,27 @@ struct Runner
 			fs::create_directories(dbg);
 		}
 		const auto res = detect::detect(img, camera, geometry, options, dbg);
-		std::cout << detect::imageToJson(name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks)
+		// L, C_L, pose_in_landmark and C_R of each detection (spec section 5).
+		std::vector<detect::JsonFields> extra;
+		for (const auto& d : res.landmarks)
+		{
+			detect::JsonFields f;
+			try
+			{
+				const auto m = pose::measure(d.detection.corners, camera, geometry, pose);
+				f.emplace_back("L", jsonVector(m.L));
+				f.emplace_back("C_L", jsonMatrix(m.C_L));
+				f.emplace_back("pose_in_landmark", jsonVector(m.pose_in_landmark));
+				f.emplace_back("C_R", jsonMatrix(m.C_R));
+			}
+			catch (const std::invalid_argument&)
+			{
+				// Degenerate corners: the detection without a measurement.
+			}
+			extra.push_back(std::move(f));
+		}
+		std::cout << detect::imageToJson(
+						 name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks, extra)
 				  << std::endl;
 		if (!draw_dir.empty())
 		{
@@ -220,7 +256,12 @@ int main(int argc, char** argv)
 				throw std::runtime_error(path + ": " + e.what());
 			}
 		}
-		if (config_arg.isSet()) r.options = detect::DetectorOptions::load(config_arg.getValue());
+		if (config_arg.isSet())
+		{
+			r.options = detect::DetectorOptions::load(config_arg.getValue());
+			mrpt::config::CConfigFile cfg(config_arg.getValue());
+			if (cfg.sectionExists("pose")) r.pose.loadFromConfigFile(cfg, "pose");
+		}
 		r.draw_dir = draw_arg.getValue();
 		r.debug_dir = debug_arg.getValue();
 		if (!r.draw_dir.empty()) fs::create_directories(r.draw_dir);
