@@ -12,6 +12,7 @@
 #include <mrpt/config/CConfigFile.h>
 
 #include <fstream>
+#include <unistd.h>
 #include <sstream>
 
 using namespace codemark;
@@ -21,7 +22,8 @@ namespace
 {
 std::string tempDir(const std::string& name)
 {
-	const std::string d = ::testing::TempDir() + "codemark_dataset_" + name;
+	// One folder per process: ctest runs tests in parallel processes.
+	const std::string d = ::testing::TempDir() + "codemark_dataset_" + std::to_string(getpid()) + "_" + name;
 	mrpt::system::deleteFilesInDirectory(d, true);
 	return d;
 }

@@ -13,6 +13,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <unistd.h>
 #include <sstream>
 
 using namespace codemark;
@@ -21,7 +22,9 @@ namespace
 {
 std::string freshDir(const std::string& name)
 {
-	const std::string d = ::testing::TempDir() + "codemark_pipeline_" + name;
+	// One folder per process: ctest runs each TEST in its own process, in
+	// parallel, and the shared dataset must not be rewritten under a reader.
+	const std::string d = ::testing::TempDir() + "codemark_pipeline_" + std::to_string(getpid()) + "_" + name;
 	mrpt::system::deleteFilesInDirectory(d, true);
 	mrpt::system::createDirectory(d);
 	return d;

@@ -1,5 +1,6 @@
 // Ground-truth path files (landmark-spec.md section 6, both forms).
 #include <codemark/filters/ground_truth.h>
+#include <codemark/landmark/text.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,25 +23,7 @@ GroundTruth GroundTruth::load(const std::string& path)
 		++lineno;
 		const auto first = line.find_first_not_of(" \t\r");
 		if (first == std::string::npos || line[first] == '#' || line[first] == '%') continue;
-		std::istringstream ss(line);
-		std::vector<double> v;
-		std::string tok;
-		while (ss >> tok)
-		{
-			try
-			{
-				std::size_t used = 0;
-				v.push_back(std::stod(tok, &used));
-				if (used != tok.size()) throw std::invalid_argument(tok);
-			}
-			catch (const std::exception&)
-			{
-				throw std::runtime_error(
-					path + ":" + std::to_string(lineno) + ": '" + tok + "' is not a number");
-			}
-			if (!std::isfinite(v.back()))
-				throw std::runtime_error(path + ":" + std::to_string(lineno) + ": non-finite value");
-		}
+		const std::vector<double> v = parseNumberRow(line, path, lineno, "#%");
 		const int n = static_cast<int>(v.size());
 		if (columns == 0)
 		{

@@ -1,4 +1,5 @@
 #include <codemark/filters/mrpt_landmarks.h>
+#include <codemark/landmark/text.h>
 
 #include <cmath>
 #include <fstream>
@@ -26,23 +27,9 @@ std::vector<std::string> tokens(std::string text)
 // A whole-token finite number, else MapFileError naming the column.
 double number(const std::string& tok, const char* field, const std::string& name, int line)
 {
-	std::size_t used = 0;
-	double v = 0;
-	try
-	{
-		v = std::stod(tok, &used);
-	}
-	catch (const std::exception&)
-	{
-		used = 0;
-	}
-	if (used == 0 || used != tok.size())
-		throw MapFileError(
-			name, line, std::string("column '") + field + "' is not a number: '" + tok + "'");
-	if (!std::isfinite(v))
-		throw MapFileError(
-			name, line, std::string("column '") + field + "' is not finite: '" + tok + "'");
-	return v;
+	if (const auto v = parseFiniteNumber(tok)) return *v;
+	throw MapFileError(
+		name, line, std::string("column '") + field + "' is not a finite number: '" + tok + "'");
 }
 }  // namespace
 

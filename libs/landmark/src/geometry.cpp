@@ -7,7 +7,7 @@
 
 namespace codemark
 {
-LandmarkGeometry LandmarkGeometry::scaled(double scale)
+LandmarkGeometry LandmarkGeometry::scaledBy(double scale) const
 {
 	if (!(scale > 0) || !std::isfinite(scale))
 	{
@@ -15,13 +15,15 @@ LandmarkGeometry LandmarkGeometry::scaled(double scale)
 		s << "landmark scale must be finite and > 0, got " << scale;
 		throw std::invalid_argument(s.str());
 	}
-	LandmarkGeometry g;
+	LandmarkGeometry g = *this;
 	g.outer_size_m *= scale;
 	g.inner_size_m *= scale;
 	g.cell_size_m *= scale;
 	g.margin_m *= scale;
 	return g;
 }
+
+LandmarkGeometry LandmarkGeometry::scaled(double scale) { return LandmarkGeometry().scaledBy(scale); }
 
 std::array<Eigen::Vector3d, 4> LandmarkGeometry::referencePoints() const
 {
@@ -62,13 +64,7 @@ void LandmarkGeometry::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(cell_size_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(margin_m, double, c, s);
 	// An optional overall scale, as in the map file's scale column.
-	const double scale = c.read_double(s, "scale", 1.0);
-	if (!(scale > 0) || !std::isfinite(scale))
-		throw std::invalid_argument("landmark [" + s + "] scale must be finite and > 0");
-	outer_size_m *= scale;
-	inner_size_m *= scale;
-	cell_size_m *= scale;
-	margin_m *= scale;
+	*this = scaledBy(c.read_double(s, "scale", 1.0));
 	validate();
 }
 

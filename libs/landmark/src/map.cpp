@@ -1,4 +1,7 @@
 #include <codemark/landmark/map.h>
+#include <codemark/landmark/text.h>
+
+#include <cstdlib>
 
 #include <cmath>
 #include <fstream>
@@ -33,23 +36,12 @@ namespace
 double parseNumber(
 	const std::string& tok, const char* field, const std::string& name, int line)
 {
-	std::size_t used = 0;
-	double v = 0;
-	try
-	{
-		v = std::stod(tok, &used);
-	}
-	catch (const std::exception&)
-	{
-		used = 0;
-	}
-	if (used != tok.size() || used == 0)
-		throw MapFileError(
-			name, line, std::string("field '") + field + "' is not a number: '" + tok + "'");
-	if (!std::isfinite(v))
-		throw MapFileError(
-			name, line, std::string("field '") + field + "' is not finite: '" + tok + "'");
-	return v;
+	if (const auto v = parseFiniteNumber(tok)) return *v;
+	const bool number = std::isnan(std::strtod(tok.c_str(), nullptr)) ||
+		std::isinf(std::strtod(tok.c_str(), nullptr));
+	throw MapFileError(
+		name, line,
+		std::string("field '") + field + (number ? "' is not finite: '" : "' is not a number: '") + tok + "'");
 }
 }  // namespace
 

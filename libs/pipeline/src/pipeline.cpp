@@ -11,15 +11,7 @@ namespace codemark::pipeline
 LandmarkGeometry geometryFor(int id, const PipelineOptions& o)
 {
 	if (o.map)
-		if (const auto* l = o.map->find(id); l && l->scale != 1.0)
-		{
-			LandmarkGeometry g = o.geometry;
-			g.outer_size_m *= l->scale;
-			g.inner_size_m *= l->scale;
-			g.cell_size_m *= l->scale;
-			g.margin_m *= l->scale;
-			return g;
-		}
+		if (const auto* l = o.map->find(id); l && l->scale != 1.0) return o.geometry.scaledBy(l->scale);
 	return o.geometry;
 }
 

@@ -1,3 +1,4 @@
+#include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -228,27 +229,7 @@ std::vector<TimedPose2D> readTrajectoryFile(const std::string& path)
 	while (std::getline(f, line))
 	{
 		++n;
-		if (const auto h = line.find_first_of("#%"); h != std::string::npos) line.erase(h);
-		std::istringstream ss(line);
-		std::vector<double> v;
-		std::string tok;
-		while (ss >> tok)
-		{
-			std::size_t used = 0;
-			double d = 0;
-			try
-			{
-				d = std::stod(tok, &used);
-			}
-			catch (const std::exception&)
-			{
-				used = 0;
-			}
-			if (used != tok.size() || !std::isfinite(d))
-				throw std::runtime_error(
-					path + ":" + std::to_string(n) + ": not a finite number: '" + tok + "'");
-			v.push_back(d);
-		}
+		const std::vector<double> v = parseNumberRow(line, path, n, "#%");
 		if (v.empty()) continue;
 		if (v.size() != 4)
 			throw std::runtime_error(

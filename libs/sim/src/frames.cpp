@@ -1,3 +1,4 @@
+#include <codemark/landmark/text.h>
 #include <codemark/sim/frames.h>
 
 #include <opencv2/core.hpp>
@@ -60,28 +61,7 @@ std::vector<mrpt::poses::CPose3D> loadCameraPoses(const std::string& path)
 	std::string line;
 	for (int n = 1; std::getline(in, line); ++n)
 	{
-		const auto hash = line.find('#');
-		if (hash != std::string::npos) line.resize(hash);
-		std::istringstream s(line);
-		std::vector<double> v;
-		std::string tok;
-		while (s >> tok)
-		{
-			size_t used = 0;
-			double x = 0;
-			try
-			{
-				x = std::stod(tok, &used);
-			}
-			catch (const std::exception&)
-			{
-				used = 0;
-			}
-			if (used != tok.size() || !std::isfinite(x))
-				throw std::runtime_error(
-					path + ":" + std::to_string(n) + ": '" + tok + "' is not a finite number");
-			v.push_back(x);
-		}
+		const std::vector<double> v = parseNumberRow(line, path, n);
 		if (v.empty()) continue;
 		if (v.size() != 6)
 			throw std::runtime_error(

@@ -23,6 +23,9 @@ struct LandmarkGeometry : public mrpt::config::CLoadableOptions
 
 	/** The A4 landmark with every size multiplied by \a scale (> 0). */
 	static LandmarkGeometry scaled(double scale);
+	/** This geometry with every size multiplied by \a scale (finite, > 0;
+	 * else std::invalid_argument). */
+	LandmarkGeometry scaledBy(double scale) const;
 
 	/** h: half-length of the vertical inner edge [m] (0.08 m by default). */
 	double innerHalf() const { return 0.5 * inner_size_m; }
