@@ -33,22 +33,8 @@ using sim::detail::Polygon3;
 
 constexpr double kNearM = 1e-3;  // the renderer's near plane
 
-struct Rigid
-{
-	Eigen::Matrix3d R;
-	Eigen::Vector3d t;
-	Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return R * p + t; }
-};
-
-Rigid toRigid(const mrpt::poses::CPose3D& pose)
-{
-	Rigid r;
-	const auto M = pose.getRotationMatrix();
-	for (int i = 0; i < 3; ++i)
-		for (int j = 0; j < 3; ++j) r.R(i, j) = M(i, j);
-	r.t = {pose.x(), pose.y(), pose.z()};
-	return r;
-}
+using sim::detail::Rigid;
+using sim::detail::toRigid;
 
 Polygon3 faceRect(const Rigid& cam_T_face, double s0, double t0, double s1, double t1)
 {

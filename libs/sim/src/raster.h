@@ -10,6 +10,8 @@
  */
 #include <opencv2/core.hpp>
 
+#include <mrpt/poses/CPose3D.h>
+
 #include <Eigen/Core>
 #include <vector>
 
@@ -42,5 +44,24 @@ Polygon3 clipNear(const Polygon3& poly, double z_min);
  * (fx x/z + cx, fy y/z + cy). */
 Polygon2 projectPinhole(
 	const Polygon3& poly, double fx, double fy, double cx, double cy);
+
+/** A rigid transform as Eigen, for transforming many points: p_a = R p_b + t
+ * for a_T_b. */
+struct Rigid
+{
+	Eigen::Matrix3d R;
+	Eigen::Vector3d t;
+	Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return R * p + t; }
+};
+
+inline Rigid toRigid(const mrpt::poses::CPose3D& pose)
+{
+	Rigid r;
+	const auto M = pose.getRotationMatrix();
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j) r.R(i, j) = M(i, j);
+	r.t = {pose.x(), pose.y(), pose.z()};
+	return r;
+}
 
 }  // namespace codemark::sim::detail

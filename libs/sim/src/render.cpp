@@ -28,23 +28,8 @@ constexpr double kNearM = 1e-3;
 /** Grey level of the occluding bar at gain 1. */
 constexpr double kOccluderGrey = 100.0;
 
-/** A rigid transform as Eigen: p_a = R p_b + t for a_T_b. */
-struct Rigid
-{
-	Eigen::Matrix3d R;
-	Eigen::Vector3d t;
-	Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return R * p + t; }
-};
-
-Rigid toRigid(const mrpt::poses::CPose3D& pose)
-{
-	Rigid r;
-	const auto M = pose.getRotationMatrix();
-	for (int i = 0; i < 3; ++i)
-		for (int j = 0; j < 3; ++j) r.R(i, j) = M(i, j);
-	r.t = {pose.x(), pose.y(), pose.z()};
-	return r;
-}
+using detail::Rigid;
+using detail::toRigid;
 
 /** What covers a point of the landmark's plane. */
 enum Paint : int
