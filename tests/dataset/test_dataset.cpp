@@ -1,5 +1,7 @@
 #include <codemark/sim/dataset.h>
 #include <gtest/gtest.h>
+
+#include "../common/serialization_io.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -36,25 +38,6 @@ DatasetOptions smallOptions()
 	o.odometry_rate_hz = 12;
 	o.seed = 3;
 	return o;
-}
-
-std::vector<mrpt::serialization::CSerializable::Ptr> readAll(const std::string& path)
-{
-	mrpt::io::CFileGZInputStream in(path);
-	auto ar = mrpt::serialization::archiveFrom(in);
-	std::vector<mrpt::serialization::CSerializable::Ptr> out;
-	for (;;)
-	{
-		try
-		{
-			out.push_back(ar.ReadObject());
-		}
-		catch (const mrpt::serialization::CExceptionEOF&)
-		{
-			break;
-		}
-	}
-	return out;
 }
 
 std::vector<std::vector<double>> readRows(const std::string& path)
@@ -112,7 +95,7 @@ TEST(Dataset, ActionsObservationsRawlog)
 	auto o = smallOptions();
 	const auto sum = writeDataset(o, dir, false, {}, 15);
 	EXPECT_EQ(sum.frames, 15);
-	const auto objs = readAll(dir + "/dataset.rawlog");
+	const auto objs = codemark::test::readRawlog(dir + "/dataset.rawlog");
 	ASSERT_EQ(objs.size(), 30u);
 	const auto gt = readRows(dir + "/gt_path.txt");
 	ASSERT_EQ(gt.size(), 15u);
@@ -144,7 +127,7 @@ TEST(Dataset, ObservationsOnlyHasOdometryAtItsOwnTimes)
 	const auto dir = tempDir("obs");
 	auto o = smallOptions();
 	const auto sum = writeDataset(o, dir, true, {}, 10);
-	const auto objs = readAll(dir + "/dataset.rawlog");
+	const auto objs = codemark::test::readRawlog(dir + "/dataset.rawlog");
 	int images = 0, odos = 0, odo_between = 0;
 	double last_t = -1, last_img_t = -1;
 	for (const auto& obj : objs)

@@ -2,6 +2,8 @@
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <gtest/gtest.h>
+
+#include "../common/serialization_io.h"
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/io/vector_loadsave.h>
@@ -27,23 +29,6 @@ namespace
 double loglik(const CCodedLandmarksMap& m, const mrpt::obs::CObservation& o, const CPose2D& p)
 {
 	return m.computeObservationLikelihood(o, CPose3D(p));
-}
-
-std::vector<uint8_t> toBytes(const CCodedLandmarksMap& m)
-{
-	mrpt::io::CMemoryStream mem;
-	auto ar = mrpt::serialization::archiveFrom(mem);
-	ar << m;
-	const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
-	return {p, p + mem.getTotalBytesCount()};
-}
-
-mrpt::serialization::CSerializable::Ptr fromBytes(const std::vector<uint8_t>& b)
-{
-	mrpt::io::CMemoryStream mem;
-	mem.assignMemoryNotOwn(b.data(), b.size());
-	auto ar = mrpt::serialization::archiveFrom(mem);
-	return ar.ReadObject();
 }
 
 /** The shipped pf.ini with a fixed seed. */
@@ -99,7 +84,7 @@ TEST(CodedLandmarksMap, SerializationRoundTrip)
 	m.setLandmarks(lms);
 	for (const CCodedLandmarksMap& in : {CCodedLandmarksMap(), m})
 	{
-		const auto obj = fromBytes(toBytes(in));
+		const auto obj = codemark::test::fromBytes(codemark::test::toBytes(in));
 		const auto out = std::dynamic_pointer_cast<CCodedLandmarksMap>(obj);
 		ASSERT_TRUE(out);
 		ASSERT_EQ(out->landmarks().landmarks.size(), in.landmarks().landmarks.size());
@@ -122,14 +107,14 @@ TEST(CodedLandmarksMap, SerializationRoundTrip)
 
 TEST(CodedLandmarksMap, UnknownVersionThrows)
 {
-	auto b = toBytes(CCodedLandmarksMap(pft::room()));
+	auto b = codemark::test::toBytes(CCodedLandmarksMap(pft::room()));
 	// MRPT's object header: 0x80|len, class name, version byte.
 	const std::string name = "codemark::CCodedLandmarksMap";
 	const auto it = std::search(b.begin(), b.end(), name.begin(), name.end());
 	ASSERT_NE(it, b.end());
-	EXPECT_NO_THROW(fromBytes(b));
+	EXPECT_NO_THROW(codemark::test::fromBytes(b));
 	*(it + static_cast<std::ptrdiff_t>(name.size())) = 99;
-	EXPECT_ANY_THROW(fromBytes(b));
+	EXPECT_ANY_THROW(codemark::test::fromBytes(b));
 }
 
 TEST(CodedLandmarksMap, BuiltFromIniByMultiMetricMap)

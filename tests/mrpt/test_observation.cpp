@@ -1,5 +1,7 @@
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <gtest/gtest.h>
+
+#include "../common/serialization_io.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CFileInputStream.h>
@@ -52,23 +54,6 @@ CObservationCodedLandmarks makeFilled()
 	return o;
 }
 
-std::vector<uint8_t> toBytes(const CObservationCodedLandmarks& o)
-{
-	mrpt::io::CMemoryStream mem;
-	auto ar = mrpt::serialization::archiveFrom(mem);
-	ar << o;
-	const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
-	return {p, p + mem.getTotalBytesCount()};
-}
-
-mrpt::serialization::CSerializable::Ptr fromBytes(const std::vector<uint8_t>& b)
-{
-	mrpt::io::CMemoryStream mem;
-	mem.assignMemoryNotOwn(b.data(), b.size());
-	auto ar = mrpt::serialization::archiveFrom(mem);
-	return ar.ReadObject();
-}
-
 void expectSame(const CObservationCodedLandmarks& a, const CObservationCodedLandmarks& b)
 {
 	EXPECT_EQ(a.sensorLabel, b.sensorLabel);
@@ -109,7 +94,7 @@ TEST(CodedLandmarksObs, RoundTripDefaultAndFilled)
 {
 	for (const auto& o : {CObservationCodedLandmarks(), makeFilled()})
 	{
-		auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(fromBytes(toBytes(o)));
+		auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(codemark::test::toBytes(o)));
 		ASSERT_TRUE(back);
 		expectSame(o, *back);
 	}
@@ -119,30 +104,30 @@ TEST(CodedLandmarksObs, GoldenFileStaysReadable)
 {
 	if (std::getenv("CODEMARK_WRITE_GOLDEN"))
 	{
-		const auto b = toBytes(makeFilled());
+		const auto b = codemark::test::toBytes(makeFilled());
 		std::ofstream(kGolden, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), b.size());
 	}
 	std::ifstream f(kGolden, std::ios::binary);
 	ASSERT_TRUE(f.good()) << kGolden;
 	const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), {});
-	auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(fromBytes(bytes));
+	auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(bytes));
 	ASSERT_TRUE(back);
 	expectSame(makeFilled(), *back);
 }
 
 TEST(CodedLandmarksObs, TruncatedBytesThrow)
 {
-	const auto b = toBytes(makeFilled());
+	const auto b = codemark::test::toBytes(makeFilled());
 	for (std::size_t n = 0; n < b.size(); n += 7)
 	{
 		std::vector<uint8_t> cut(b.begin(), b.begin() + n);
-		EXPECT_ANY_THROW(fromBytes(cut)) << "truncated at " << n;
+		EXPECT_ANY_THROW(codemark::test::fromBytes(cut)) << "truncated at " << n;
 	}
 }
 
 TEST(CodedLandmarksObs, BitFlipsNeverCrash)
 {
-	const auto b = toBytes(makeFilled());
+	const auto b = codemark::test::toBytes(makeFilled());
 	std::mt19937 rng(11);
 	int thrown = 0, parsed = 0;
 	for (int trial = 0; trial < 1000; ++trial)
@@ -152,7 +137,7 @@ TEST(CodedLandmarksObs, BitFlipsNeverCrash)
 		for (int k = 0; k < flips; ++k) f[rng() % f.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
 		try
 		{
-			auto o = fromBytes(f);
+			auto o = codemark::test::fromBytes(f);
 			++parsed;
 			if (auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
 			{
@@ -171,13 +156,13 @@ TEST(CodedLandmarksObs, BitFlipsNeverCrash)
 
 TEST(CodedLandmarksObs, UnknownVersionThrows)
 {
-	auto b = toBytes(makeFilled());
+	auto b = codemark::test::toBytes(makeFilled());
 	// MRPT's object header: 0x80|len, class name, version byte.
 	const std::string name = "codemark::CObservationCodedLandmarks";
 	const auto it = std::search(b.begin(), b.end(), name.begin(), name.end());
 	ASSERT_NE(it, b.end());
 	*(it + name.size()) = 99;
-	EXPECT_ANY_THROW(fromBytes(b));
+	EXPECT_ANY_THROW(codemark::test::fromBytes(b));
 }
 
 TEST(CodedLandmarksObs, BearingRangeTwin)

@@ -2,6 +2,8 @@
 #include <codemark/pipeline/annotate.h>
 #include <codemark/sim/dataset.h>
 #include <gtest/gtest.h>
+
+#include "../common/serialization_io.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
@@ -49,25 +51,6 @@ const Dataset& dataset(bool obs_only)
 	return cache[obs_only] = d;
 }
 
-std::vector<mrpt::serialization::CSerializable::Ptr> readAll(const std::string& path)
-{
-	mrpt::io::CFileGZInputStream in(path);
-	auto ar = mrpt::serialization::archiveFrom(in);
-	std::vector<mrpt::serialization::CSerializable::Ptr> out;
-	for (;;)
-	{
-		try
-		{
-			out.push_back(ar.ReadObject());
-		}
-		catch (const mrpt::serialization::CExceptionEOF&)
-		{
-			break;
-		}
-	}
-	return out;
-}
-
 std::string slurp(const std::string& p)
 {
 	std::ifstream f(p, std::ios::binary);
@@ -93,7 +76,7 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 	const auto s = pipeline::annotateRawlog(d.dir + "/dataset.rawlog", out, o);
 	EXPECT_EQ(s.images, 80);
 	EXPECT_TRUE(s.actions_observations);
-	const auto objs = readAll(out);
+	const auto objs = codemark::test::readRawlog(out);
 	ASSERT_EQ(objs.size(), 160u);
 	const auto cam_on_robot = sim::DatasetOptions().cameraPoseOnRobot();
 	int checked = 0, within = 0;
@@ -160,7 +143,7 @@ TEST(Annotate, ObservationsOnlyFormatAndBearingRange)
 	const auto s = pipeline::annotateRawlog(d.dir + "/dataset.rawlog", out, o);
 	EXPECT_FALSE(s.actions_observations);
 	int lms = 0, brs = 0, imgs = 0;
-	for (const auto& obj : readAll(out))
+	for (const auto& obj : codemark::test::readRawlog(out))
 	{
 		lms += !!std::dynamic_pointer_cast<CObservationCodedLandmarks>(obj);
 		brs += !!std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(obj);
@@ -193,7 +176,7 @@ TEST(Annotate, BadInputsStopWithTheEntryIndex)
 
 	// A truncated copy (uncompressed, cut in the middle of an entry).
 	{
-		const auto objs = readAll(d.dir + "/dataset.rawlog");
+		const auto objs = codemark::test::readRawlog(d.dir + "/dataset.rawlog");
 		mrpt::io::CFileOutputStream f(dir + "/full.rawlog");
 		auto ar = mrpt::serialization::archiveFrom(f);
 		for (std::size_t i = 0; i < 10; ++i) ar << *objs[i];
