@@ -35,7 +35,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> map(
 			"", "map", "landmark map: each ID's scale column sets its size", false, "", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> config(
-			"", "config", "ini with [detector] and [pose] sections (share/codemark/detector.ini "
+			"", "config", "ini with [DETECTOR] and [pose] sections (share/codemark/detector.ini "
 			"keys; pose: method = ClosedForm|General6Dof, sigma_px)", false, "", "INI", cmd);
 		TCLAP::SwitchArg br(
 			"", "bearing-range", "also insert the CObservationBearingRange twin (<CAM>_BR)", cmd);
@@ -65,7 +65,7 @@ int main(int argc, char** argv)
 			if (!std::ifstream(config.getValue()).good())
 				throw std::runtime_error(config.getValue() + ": cannot open");
 			mrpt::config::CConfigFile cfg(config.getValue());
-			o.pipeline.detector.loadFromConfigFile(cfg, "detector");
+			o.pipeline.detector.loadFromConfigFile(cfg, "DETECTOR");
 			o.pipeline.pose.loadFromConfigFile(cfg, "pose");
 		}
 

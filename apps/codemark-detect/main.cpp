@@ -221,7 +221,8 @@ int main(int argc, char** argv)
 			false, "", "LM.ini", cmd);
 		TCLAP::ValueArg<std::string> config_arg("", "config",
 			"Detector parameters: ini file with a [DETECTOR] section (share/codemark/detector.ini "
-			"lists every parameter with its default and unit). Default: the built-in defaults.",
+			"lists every parameter with its default and unit), and optionally a [pose] section "
+			"(method = ClosedForm|General6Dof, sigma_px, sigma_y_px). Default: the built-in defaults.",
 			false, "", "detector.ini", cmd);
 		TCLAP::ValueArg<std::string> draw_arg("", "draw",
 			"Folder (created when missing) that receives one overlay PNG per image: the "

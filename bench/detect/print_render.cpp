@@ -45,24 +45,7 @@ Polygon3 faceRect(const Rigid& cam_T_face, double s0, double t0, double s1, doub
 }
 
 // As libs/sim's render.cpp (anonymous there).
-cv::Rect pixelBounds(const Polygon2& pts, int width, int height, int grow)
-{
-	double minx = 1e300, maxx = -1e300, miny = 1e300, maxy = -1e300;
-	for (const auto& p : pts)
-	{
-		if (!p.allFinite()) continue;
-		minx = std::min(minx, p.x());
-		maxx = std::max(maxx, p.x());
-		miny = std::min(miny, p.y());
-		maxy = std::max(maxy, p.y());
-	}
-	const double x0 = std::clamp(std::floor(minx) - grow, 0.0, double(width));
-	const double x1 = std::clamp(std::ceil(maxx) + grow, -1.0, double(width - 1));
-	const double y0 = std::clamp(std::floor(miny) - grow, 0.0, double(height));
-	const double y1 = std::clamp(std::ceil(maxy) + grow, -1.0, double(height - 1));
-	if (x1 < x0 || y1 < y0) return {};
-	return cv::Rect(int(x0), int(y0), int(x1 - x0) + 1, int(y1 - y0) + 1);
-}
+using sim::detail::pixelBounds;
 
 /** A marker from its cell image: \a cells is n x n (row 0 at the top as
  * seen from the front, non-zero = white); the reference square is the

@@ -10,6 +10,9 @@
  */
 #include <opencv2/core.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 #include <mrpt/poses/CPose3D.h>
 
 #include <Eigen/Core>
@@ -62,6 +65,29 @@ inline Rigid toRigid(const mrpt::poses::CPose3D& pose)
 		for (int j = 0; j < 3; ++j) r.R(i, j) = M(i, j);
 	r.t = {pose.x(), pose.y(), pose.z()};
 	return r;
+}
+
+/** Pixel rectangle (inclusive) of the image that a set of points touches,
+ * grown by \a grow px; empty when outside. */
+inline cv::Rect pixelBounds(const std::vector<Eigen::Vector2d>& pts, int width, int height, int grow)
+{
+	double minx = 1e300, maxx = -1e300, miny = 1e300, maxy = -1e300;
+	for (const auto& p : pts)
+	{
+		if (!p.allFinite()) continue;
+		minx = std::min(minx, p.x());
+		maxx = std::max(maxx, p.x());
+		miny = std::min(miny, p.y());
+		maxy = std::max(maxy, p.y());
+	}
+	// Clamp in double before converting: points near the near plane project
+	// far outside the image.
+	const double x0 = std::clamp(std::floor(minx) - grow, 0.0, double(width));
+	const double x1 = std::clamp(std::ceil(maxx) + grow, -1.0, double(width - 1));
+	const double y0 = std::clamp(std::floor(miny) - grow, 0.0, double(height));
+	const double y1 = std::clamp(std::ceil(maxy) + grow, -1.0, double(height - 1));
+	if (x1 < x0 || y1 < y0) return {};
+	return cv::Rect(int(x0), int(y0), int(x1 - x0) + 1, int(y1 - y0) + 1);
 }
 
 }  // namespace codemark::sim::detail
