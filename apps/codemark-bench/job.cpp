@@ -1,0 +1,251 @@
+// codemark-bench: one job = one dataset through one method, and the metrics
+// libs/filters does not compute (RPE, aligned ATE, detection rate).
+#include <codemark/filters/ground_truth.h>
+#include <codemark/filters/mrpt_landmarks.h>
+#include <codemark/filters/stepper.h>
+#include <codemark/landmark/camera.h>
+#include <codemark/mrpt/CObservationCodedLandmarks.h>
+#include <codemark/sim/frames.h>
+#include <codemark/sim/render.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/math/wrap2pi.h>
+#include <mrpt/random/RandomGenerators.h>
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "bench.h"
+
+namespace codemark::bench
+{
+using mrpt::poses::CPose2D;
+using Clock = std::chrono::steady_clock;
+
+namespace
+{
+double seconds(Clock::time_point a, Clock::time_point b)
+{
+	return std::chrono::duration<double>(b - a).count();
+}
+
+// One line of an exception: MRPT's carry a header, location and backtrace.
+std::string oneLine(const std::exception& e)
+{
+	std::string s = e.what();
+	const auto header = s.find("==== MRPT exception ====");
+	const std::string prefix = header == std::string::npos ? "" : s.substr(0, header);
+	const auto msg = s.find("Message:");
+	if (msg != std::string::npos)
+	{
+		std::string m = s.substr(msg + 8, s.find('\n', msg) - msg - 8);
+		m.erase(0, m.find_first_not_of(' '));
+		return prefix + m;
+	}
+	return s.substr(0, s.find('\n'));
+}
+
+// [localize] initial pose, as codemark-localize reads it
+// (filters/src/outputs.cpp keeps its reader private).
+std::optional<filters::PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg)
+{
+	if (!cfg.read_bool("localize", "initial_pose_known", false)) return std::nullopt;
+	filters::PoseEstimate e;
+	e.initialized = true;
+	e.mean = CPose2D(cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
+		mrpt::DEG2RAD(cfg.read_double("localize", "initial_yaw_deg", 0)));
+	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
+	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
+	if (!(sxy > 0) || !(syaw > 0))
+		throw std::invalid_argument("[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
+	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+	return e;
+}
+
+// Compares one frame's landmark observation with what the true pose shows.
+void tallyDetections(const CObservationCodedLandmarks& obs, const CPose2D& truth, const LandmarkMap& map,
+	const std::optional<CameraModel>& camera_override, double min_span_px, DetectionStats& d)
+{
+	sim::Scene scene;
+	scene.map = map;
+	scene.camera = camera_override ? *camera_override : CameraModel(obs.camera);
+	scene.world_T_camera = mrpt::poses::CPose3D(truth) + obs.cameraPose;
+	std::set<int> in_view, visible;
+	for (const auto& t : sim::groundTruth(scene))
+	{
+		if (sim::isInView(t, scene.camera)) visible.insert(t.id);
+		if (t.fully_visible && std::sqrt(t.area_px) >= min_span_px) in_view.insert(t.id);
+	}
+	std::set<int> right;
+	for (const auto& s : obs.sightings)
+	{
+		if (in_view.count(s.id)) right.insert(s.id);
+		if (!visible.count(s.id)) ++d.wrong_ids;
+	}
+	++d.frames;
+	d.sightings_in_view += static_cast<long>(in_view.size());
+	d.sightings_detected += static_cast<long>(right.size());
+	if (!in_view.empty())
+	{
+		++d.frames_in_view;
+		if (!right.empty()) ++d.frames_detected;
+	}
+}
+}  // namespace
+
+std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, double interval_s)
+{
+	std::vector<const filters::PathRow*> ok;
+	for (const auto& r : rows)
+		if (r.estimate.initialized && r.truth) ok.push_back(&r);
+	Rpe rpe;
+	double st = 0, sy = 0;
+	std::size_t j = 0;
+	for (std::size_t i = 0; i < ok.size(); ++i)
+	{
+		j = std::max(j, i + 1);
+		while (j < ok.size() && ok[j]->timestamp - ok[i]->timestamp < interval_s) ++j;
+		if (j >= ok.size()) break;
+		const CPose2D rel_gt = *ok[j]->truth - *ok[i]->truth;
+		const CPose2D rel_est = ok[j]->estimate.mean - ok[i]->estimate.mean;
+		const CPose2D e = rel_est - rel_gt;  // rel_gt^-1 (+) rel_est
+		st += e.x() * e.x() + e.y() * e.y();
+		sy += mrpt::math::wrapToPi(e.phi()) * mrpt::math::wrapToPi(e.phi());
+		++rpe.pairs;
+	}
+	if (rpe.pairs == 0) return std::nullopt;
+	rpe.trans_rmse_m = std::sqrt(st / rpe.pairs);
+	rpe.yaw_rmse_deg = std::sqrt(sy / rpe.pairs) * 180.0 / M_PI;
+	return rpe;
+}
+
+std::optional<Alignment> alignPath(const std::vector<filters::PathRow>& rows)
+{
+	std::vector<Eigen::Vector2d> e, g;
+	for (const auto& r : rows)
+		if (r.estimate.initialized && r.truth)
+		{
+			e.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
+			g.emplace_back(r.truth->x(), r.truth->y());
+		}
+	if (e.size() < 2) return std::nullopt;
+	// Least-squares rotation and translation (Umeyama without scale): from
+	// the centred cross-covariance, the rotation angle is atan2 of its
+	// antisymmetric over its symmetric part.
+	Eigen::Vector2d me = Eigen::Vector2d::Zero(), mg = Eigen::Vector2d::Zero();
+	for (std::size_t i = 0; i < e.size(); ++i) me += e[i], mg += g[i];
+	me /= e.size(), mg /= g.size();
+	double sxx = 0, sxy = 0;
+	for (std::size_t i = 0; i < e.size(); ++i)
+	{
+		const Eigen::Vector2d a = e[i] - me, b = g[i] - mg;
+		sxx += a.dot(b);
+		sxy += a.x() * b.y() - a.y() * b.x();
+	}
+	const double th = std::atan2(sxy, sxx);
+	const Eigen::Rotation2Dd R(th);
+	Alignment a;
+	a.yaw_rad = th;
+	const Eigen::Vector2d t = mg - R * me;
+	a.tx = t.x(), a.ty = t.y();
+	double s = 0;
+	for (std::size_t i = 0; i < e.size(); ++i) s += (R * e[i] + t - g[i]).squaredNorm();
+	a.ate_m = std::sqrt(s / e.size());
+	return a;
+}
+
+JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& method, const std::string& out_dir,
+	unsigned seed, const std::function<void(double)>& progress)
+{
+	JobResult r;
+	r.dataset = ds.name;
+	r.method = method;
+	r.out_dir = out_dir;
+	const auto t_start = Clock::now();
+	try
+	{
+		mrpt::random::getRandomGenerator().randomize(seed);
+		const std::string ini = cfg.config_dir + "/" + method + ".ini";
+		mrpt::config::CConfigFile mcfg(ini);
+		auto& s = r.summary;
+		s.method = method;
+		const bool mrpt_map = filters::isMrptLandmarksFile(ds.map);
+		const LandmarkMap map = mrpt_map ? filters::loadMrptLandmarksFile(ds.map) : LandmarkMap::load(ds.map);
+		const filters::GroundTruth gt = filters::GroundTruth::load(ds.gt);
+		std::optional<CameraModel> camera;
+		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
+
+		filters::StepperOptions so;
+		so.loadFromConfigFile(mcfg, "stepper");
+		pipeline::PipelineOptions po;
+		po.detector.loadFromConfigFile(mcfg, "detector");
+		po.pose.loadFromConfigFile(mcfg, "pose");
+		if (!mrpt_map) po.map = map;
+		po.camera_override = camera;
+
+		// ekf-slam builds its own map: the dataset's map is its ground truth
+		// (for the plots and the detection rate), not a prior.
+		const LandmarkMap prior = method == "ekf-slam" ? LandmarkMap() : map;
+		auto filter = filters::makeLocalizer(method, mcfg, prior, initialPose(mcfg));
+		filters::RawlogStepper stepper(ds.rawlog, so, po);
+		filters::RawlogStep step;
+		double filter_s = 0, detect_s = 0, first_t = 0;
+		auto t_read = Clock::now();
+		while (true)
+		{
+			const bool more = stepper.next(step);
+			const auto t0 = Clock::now();
+			if (!more) break;
+			if (step.images_detected > 0)
+			{
+				r.detection.images += step.images_detected;
+				detect_s += seconds(t_read, t0);
+			}
+			const filters::StepStats st = filter->step(step.odometry.get(), step.observations);
+			filter_s += seconds(t0, Clock::now());
+			filters::PathRow row;
+			row.step = step.index;
+			row.timestamp = step.timestamp;
+			row.estimate = filter->estimate();
+			row.stats = st;
+			row.truth = gt.poseAt(step.index, step.timestamp);
+			if (row.truth && !mrpt_map)
+				for (const auto& o : step.observations)
+					if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
+						tallyDetections(*lm, *row.truth, map, camera, cfg.min_span_px, r.detection);
+			if (step.index == 0) first_t = step.timestamp;
+			if (row.estimate.initialized && s.first_fix_step < 0)
+			{
+				s.first_fix_step = step.index;
+				s.first_fix_time_s = step.timestamp - first_t;
+			}
+			s.sightings_used += st.used;
+			s.sightings_rejected += st.rejected;
+			s.sightings_unknown_id += st.unknown_id;
+			s.reinitializations += st.reinitialized ? 1 : 0;
+			s.rows.push_back(std::move(row));
+			++s.steps;
+			if (progress) progress(stepper.progress());
+			t_read = Clock::now();
+		}
+		s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
+		s.detect_ms_per_image = r.detection.images ? 1000.0 * detect_s / r.detection.images : 0.0;
+		r.detection.detect_ms_per_image = s.detect_ms_per_image;
+		s.slam_map = filter->landmarks();
+		s.metrics = filters::computeMetrics(s.rows);
+		r.rpe = relativePoseError(s.rows, cfg.rpe_interval_s);
+		r.aligned = alignPath(s.rows);
+		filters::writeOutputs(s, map, out_dir);
+		r.ok = true;
+	}
+	catch (const std::exception& e)
+	{
+		r.error = oneLine(e);
+	}
+	r.wall_s = seconds(t_start, Clock::now());
+	if (progress) progress(1.0);
+	return r;
+}
+
+}  // namespace codemark::bench
