@@ -3,7 +3,8 @@
 # whole chain on the embedded default dataset, writing into demo-out/ (or $1):
 #   simulate (a room with 12 landmarks, one loop, noisy odometry, rendered
 #   images) -> annotate (detect + measure every image) -> localize with the
-#   EKF and the particle filter -> a short summary and the plots.
+#   EKF and the particle filter -> benchmark view of both runs (errors over
+#   time against the filters' 3-sigma bounds) -> a short summary and the plots.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -13,6 +14,7 @@ bash scripts/build.sh
 BIN=$ROOT/build/apps
 CFG=$ROOT/share/codemark/config
 rm -rf "$OUT" && mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 start=$(date +%s)
 
 echo "== 1/4 simulate: $OUT/dataset"
@@ -21,23 +23,37 @@ echo "== 2/4 annotate: detect and measure every image"
 "$BIN/codemark-annotate/codemark-annotate" -i "$OUT/dataset/dataset.rawlog" \
   -o "$OUT/dataset/annotated.rawlog"
 for method in ekf pf; do
-  echo "== localize: $method"
+  echo "== 3/4 localize: $method"
   "$BIN/codemark-localize/codemark-localize" --config "$CFG/$method.ini" --method "$method" \
     --rawlog "$OUT/dataset/annotated.rawlog" --map "$OUT/dataset/map.txt" \
     --gt "$OUT/dataset/gt_path.txt" --out "$OUT/$method"
 done
+echo "== 4/4 benchmark view: codemark-bench over the same rawlog (ekf, pf)"
+cat > "$OUT/bench.ini" <<INI
+# codemark-bench's ini for the demo dataset (share/codemark/bench.ini documents the keys).
+[bench]
+config_dir = $CFG
+[dataset:demo]
+rawlog = dataset/annotated.rawlog
+map    = dataset/map.txt
+gt     = dataset/gt_path.txt
+INI
+"$BIN/codemark-bench/codemark-bench" --config "$OUT/bench.ini" --out "$OUT/bench" --methods ekf,pf
 
 echo
-echo "== summary (ground truth: $OUT/dataset/gt_path.txt)"
-printf '%-6s %8s %10s %12s %10s %12s\n' method steps ATE[m] yawRMSE[deg] NEES ms/step
-# A field of a summary.json (flat, one "key": value per line).
-field() { sed -n "s/^ *\"$2\": *\([^,]*\),*$/\1/p" "$1"; }
-for method in ekf pf; do
-  j="$OUT/$method/summary.json"
-  printf '%-6s %8s %10.4f %12.3f %10.2f %12.4f\n' "$method" "$(field "$j" steps)" \
-    "$(field "$j" ate_rmse_m)" "$(field "$j" yaw_rmse_deg)" "$(field "$j" nees_mean)" \
-    "$(field "$j" time_per_step_ms)"
-done
+echo "== summary (ground truth: $OUT/dataset/gt_path.txt; RPE over 1 s; NEES 95% band of a consistent filter)"
+printf '%-6s %6s %9s %9s %9s %13s %16s %10s %9s\n' method steps ATE[m] max[m] RPE[m] yawRMSE[deg] \
+  "NEES [band]" fix[s] ms/step
+# results.csv: one row per method; the columns are named in its header.
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+  { printf "%-6s %6d %9.4f %9.4f %9.4f %13.3f %6.2f [%.2f,%.2f] %10.1f %9.4f\n", $c["method"],
+    $c["steps"], $c["ate_m"], $c["max_error_m"], $c["rpe_trans_m"], $c["yaw_rmse_deg"],
+    $c["nees_mean"], $c["nees_low_95"], $c["nees_high_95"], $c["first_fix_s"],
+    $c["filter_ms_per_step"] }' "$OUT/bench/results.csv"
+echo "(codemark-bench seeds each job; codemark-localize's pf line above draws other random numbers)"
 echo
-echo "plots: $OUT/ekf/trajectory.png $OUT/pf/trajectory.png"
+echo "plots: $OUT/ekf/trajectory.png $OUT/pf/trajectory.png (estimate, truth, 95% ellipses)"
+echo "       $OUT/bench/demo-error.png (position error against time with the 3-sigma bound)"
+echo "       $OUT/bench/demo-trajectories.png (both estimates over the ground truth)"
+echo "report: $OUT/bench/report.md"
 echo "demo: done in $(( $(date +%s) - start )) s after the build; outputs in $OUT/"

@@ -126,7 +126,7 @@ void drawErrorPanel(cv::Mat& img, const cv::Rect& box, const JobResult& r, doubl
 	if (err.size() > 1) cv::polylines(img, err, false, colour, 2, cv::LINE_AA);
 	cv::putText(img,
 		r.method + ": |position error| (colour), 3-sigma bound (black)" +
-			(r.method == "ekf-slam" ? "; in the map frame, unaligned" : ""), cv::Point(box.x + 5, box.y + 15),
+			(r.method == "ekf-slam" ? "; in the map frame, unaligned" : ""), cv::Point(box.x, box.y - 7),
 		cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 }
 }  // namespace
@@ -160,16 +160,17 @@ std::vector<std::string> writeDatasetPlots(const std::string& name, const std::v
 		std::sort(values.begin(), values.end());
 		return std::max(0.005, 1.2 * values[static_cast<std::size_t>(0.95 * (values.size() - 1))]);
 	};
-	const int W = 900, ph = 150, margin = 25;
-	cv::Mat img(margin + static_cast<int>(ok.size()) * (ph + margin) + 10, W, CV_8UC3, cv::Scalar(255, 255, 255));
+	// Each panel: a label line above its box.
+	const int W = 900, ph = 150, margin = 28, top = 45;
+	cv::Mat img(top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3, cv::Scalar(255, 255, 255));
 	cv::putText(img,
 		name + ": position error against time [" + fmt(t1 - t0, 0) + " s], 3-sigma = 3 sqrt(largest eigenvalue of the xy covariance)",
 		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	for (std::size_t k = 0; k < ok.size(); ++k)
-		drawErrorPanel(img, cv::Rect(10, margin + static_cast<int>(k) * (ph + margin), W - 20, ph), *ok[k], t0, t1,
+		drawErrorPanel(img, cv::Rect(10, top + static_cast<int>(k) * (ph + margin), W - 20, ph), *ok[k], t0, t1,
 			scaleOf(*ok[k]), kMethodColours[k % 6]);
 	const std::string err_file = name + "-error.png";
-	if (!cv::imwrite(dir + "/" + err_file, img)) throw std::runtime_error(dir + "/" + err_file + ": cannot write");
+	if (!cv::imwrite(dir + "/" + err_file, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw std::runtime_error(dir + "/" + err_file + ": cannot write");
 	files.push_back(err_file);
 
 	// Trajectories: ground truth, every method, the landmarks.
@@ -230,7 +231,7 @@ std::vector<std::string> writeDatasetPlots(const std::string& name, const std::v
 			kMethodColours[k % 6], 1, cv::LINE_AA);
 	}
 	const std::string tr_file = name + "-trajectories.png";
-	if (!cv::imwrite(dir + "/" + tr_file, tr)) throw std::runtime_error(dir + "/" + tr_file + ": cannot write");
+	if (!cv::imwrite(dir + "/" + tr_file, tr, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw std::runtime_error(dir + "/" + tr_file + ": cannot write");
 	files.push_back(tr_file);
 	return files;
 }
