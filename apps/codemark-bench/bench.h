@@ -106,12 +106,13 @@ struct JobResult
 
 /** Runs \a method over \a ds and writes its spec section 6 outputs into
  * \a out_dir. Never throws: failures are reported in JobResult::error.
- * \a progress(fraction) after each frame. \a seed seeds the thread's MRPT
- * random generator first, so that results do not depend on which pool
- * thread ran the job. */
+ * \a progress(fraction) after each frame. \a seed, when given, first seeds
+ * MRPT's random generator (mrpt::random::getRandomGenerator(), shared by
+ * the whole process): the caller must then keep every other job from
+ * touching the generator while this one runs. */
 JobResult runJob(
 	const BenchConfig& cfg, const Dataset& ds, const std::string& method, const std::string& out_dir,
-	unsigned seed, const std::function<void(double)>& progress = {});
+	std::optional<unsigned> seed, const std::function<void(double)>& progress = {});
 
 /** RPE of \a rows over \a interval_s; none when no pair matches. */
 std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, double interval_s);

@@ -156,7 +156,7 @@ std::optional<Alignment> alignPath(const std::vector<filters::PathRow>& rows)
 }
 
 JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& method, const std::string& out_dir,
-	unsigned seed, const std::function<void(double)>& progress)
+	std::optional<unsigned> seed, const std::function<void(double)>& progress)
 {
 	JobResult r;
 	r.dataset = ds.name;
@@ -165,7 +165,7 @@ JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& m
 	const auto t_start = Clock::now();
 	try
 	{
-		mrpt::random::getRandomGenerator().randomize(seed);
+		if (seed) mrpt::random::getRandomGenerator().randomize(*seed);
 		const std::string ini = cfg.config_dir + "/" + method + ".ini";
 		mrpt::config::CConfigFile mcfg(ini);
 		auto& s = r.summary;
