@@ -3,7 +3,7 @@
 # one loop of the default room, seed 5): two datasets (images detected on the
 # fly, and the annotated rawlog) x two methods (ekf, pf) on two threads.
 # Checks results.csv's columns, that every number is finite, and plausible
-# values; then that one thread gives the same accuracy figures as two.
+# values; then that one thread gives the same figures as two.
 # usage: bench_app.sh CODEMARK_BENCH DATA_DIR CONFIG_DIR
 set -euo pipefail
 bench=$1 data=$2 config_dir=$3
@@ -80,8 +80,10 @@ for r in rows:
 print("results.csv: columns and values ok")
 PY
 
-# One thread: the same accuracy figures (each job seeds its own random generator).
-"$bench" -q --config "$tmp/bench.ini" --out "$tmp/out1" --jobs 1 --methods ekf,pf
+# One thread gives the same figures as two (each pf job seeds MRPT's generator
+# and runs alone on it): rerun the annotated dataset (no detection, fast).
+sed -n '/^\[bench\]/,/^data_dir/p; /^\[dataset:annotated\]/,$p' "$tmp/bench.ini" > "$tmp/annotated.ini"
+"$bench" -q --config "$tmp/annotated.ini" --out "$tmp/out1" --jobs 1 --methods ekf,pf
 cols='1,2,4,5,6,7,8,10,11,12,13,14,15,16'
-diff <(cut -d, -f$cols "$tmp/out1/results.csv") <(cut -d, -f$cols "$csv")
+diff <(cut -d, -f$cols "$tmp/out1/results.csv") <(grep -E '^(dataset|annotated),' "$csv" | cut -d, -f$cols)
 echo "bench_app: ok"
