@@ -47,13 +47,15 @@ int main(int argc, char** argv)
 			"codemark-localize outputs in <dataset>/<method>/. Exits non-zero if any job failed.",
 			' ', "0.1");
 		TCLAP::ValueArg<std::string> config("c", "config", "the benchmark ini", true, "", "BENCH.ini", cmd);
-		TCLAP::ValueArg<std::string> out("o", "out", "output directory (created)", false, "bench-out", "DIR", cmd);
+		TCLAP::ValueArg<std::string> out(
+			"o", "out", "output directory, created (default: bench-out)", false, "bench-out", "DIR", cmd);
 		TCLAP::ValueArg<unsigned> jobs(
 			"j", "jobs", "parallel jobs (default: the hardware concurrency)", false, 0, "N", cmd);
 		TCLAP::ValueArg<std::string> methods("m", "methods",
 			"comma-separated methods, overriding [bench] methods (ekf,ekf-pose,ekf-slam,pf)", false, "",
 			"LIST", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		BenchConfig cfg = loadBenchConfig(config.getValue());
@@ -178,9 +180,15 @@ int main(int argc, char** argv)
 				  << failed << " failed; wrote " << dir << "/report.md and results.csv\n";
 		return failed ? 1 : 0;
 	}
+	catch (const TCLAP::ExitException& e)
+	{
+		return e.getExitStatus();  // after --help or --version
+	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-bench: " << e.error() << " (" << e.argId() << ")\n";
+		const std::string id = e.argId();
+		const bool named = id.find_first_not_of(' ') != std::string::npos;
+		std::cerr << "codemark-bench: " << (named ? id + ": " : "") << e.error() << " (see --help)\n";
 	}
 	catch (const std::exception& e)
 	{
