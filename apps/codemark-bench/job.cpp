@@ -31,7 +31,17 @@ double seconds(Clock::time_point a, Clock::time_point b)
 }
 
 // One line of an exception: MRPT's carry a header, location and backtrace.
+// Control characters (e.g. from a corrupt file's bytes quoted in the
+// message) become '?'.
+std::string oneLineRaw(const std::exception& e);
 std::string oneLine(const std::exception& e)
+{
+	std::string s = oneLineRaw(e);
+	for (auto& c : s)
+		if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+	return s;
+}
+std::string oneLineRaw(const std::exception& e)
 {
 	std::string s = e.what();
 	const auto header = s.find("==== MRPT exception ====");

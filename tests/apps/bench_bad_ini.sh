@@ -36,6 +36,16 @@ printf '[datasets]\nx = 1\n' > "$tmp/bad_section.ini"
 expect bad_section "bad_section.ini: [datasets]: unknown section"
 printf '[bench]\nmin_span_px = 30\n' > "$tmp/no_dataset.ini"
 expect no_dataset "no_dataset.ini: no [dataset:NAME] section"
+# Bad arguments: one line naming the argument.
+printf '[dataset:a]\n%s\n' "$good" > "$tmp/good.ini"
+for args in "--methods ekf,kalman|--methods: unknown method 'kalman'" "--jobs abc|--jobs"; do
+  rc=0
+  "$bench" -q --config "$tmp/good.ini" --out "$tmp/out" ${args%%|*} 2> "$tmp/err" > /dev/null || rc=$?
+  if [ "$rc" -ne 1 ] || ! grep -qF -- "${args#*|}" "$tmp/err" || [ "$(wc -l < "$tmp/err")" -ne 1 ]; then
+    echo "args '${args%%|*}': exit $rc, stderr:"; cat "$tmp/err"; exit 1
+  fi
+  echo "args '${args%%|*}': ok: $(cat "$tmp/err")"
+done
 # A dataset whose rawlog is not a rawlog: the job fails with its name, the others still run.
 head -c 3000 /dev/urandom > "$tmp/junk.rawlog"
 printf '[dataset:junk]\nrawlog = %s/junk.rawlog\nmap = %s/map.txt\ngt = %s/gt_path.txt\n' "$tmp" "$data" "$data" \
