@@ -14,6 +14,7 @@
 #include <mrpt/system/datetime.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -150,7 +151,7 @@ struct RawlogStepper::Impl
 		else if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj))
 		{
 			actions_observations = true;
-			onActions(*acts);
+			onActions(*acts, entry);
 		}
 		else if (auto o = std::dynamic_pointer_cast<CObservation>(obj))
 			onObservation(o, entry);
@@ -161,7 +162,7 @@ struct RawlogStepper::Impl
 		return nullptr;
 	}
 
-	void onActions(const mrpt::obs::CActionCollection& acts)
+	void onActions(const mrpt::obs::CActionCollection& acts, long entry)
 	{
 		for (const auto& a : acts)
 		{
@@ -169,6 +170,12 @@ struct RawlogStepper::Impl
 			if (!mv || !mv->poseChange) continue;
 			mrpt::poses::CPosePDFGaussian g;
 			g.copyFrom(*mv->poseChange);
+			if (!std::isfinite(g.mean.x()) || !std::isfinite(g.mean.y()) || !std::isfinite(g.mean.phi()))
+				throw std::runtime_error(where(entry) + ": odometry increment (CActionRobotMovement2D) is not finite: " +
+					g.mean.asString());
+			if (!g.cov.asEigen().allFinite())
+				throw std::runtime_error(
+					where(entry) + ": odometry increment (CActionRobotMovement2D) has a non-finite covariance");
 			if (!acc) acc = g;
 			else *acc += g;
 			break;  // one movement per collection
@@ -222,6 +229,10 @@ struct RawlogStepper::Impl
 	{
 		if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(o))
 		{
+			if (!std::isfinite(odo->odometry.x()) || !std::isfinite(odo->odometry.y()) ||
+				!std::isfinite(odo->odometry.phi()))
+				throw std::runtime_error(where(entry) + ": odometry reading (CObservationOdometry '" +
+					odo->sensorLabel + "') is not finite: " + odo->odometry.asString());
 			closeOpen();
 			const double t = mrpt::Clock::toDouble(odo->timestamp);
 			const double interval = last_odo ? t - last_odo->first : 0.0;
@@ -299,6 +310,40 @@ struct RawlogStepper::Impl
 		}
 	}
 
+	// NaN or inf in a measurement the filters fuse: a clear error naming the
+	// entry, never a silently wrong estimate.
+	void checkFinite(const CObservation& o, long entry) const
+	{
+		if (const auto* c = dynamic_cast<const CObservationCodedLandmarks*>(&o))
+		{
+			for (std::size_t i = 0; i < c->sightings.size(); ++i)
+			{
+				const auto& t = c->sightings[i];
+				const char* bad = !t.L.allFinite() ? "L"
+					: !t.C_L.allFinite()           ? "C_L"
+					: !t.pose_in_landmark.allFinite() ? "pose_in_landmark"
+					: !t.C_R.allFinite()           ? "C_R"
+												   : nullptr;
+				if (bad)
+					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): sighting #" +
+						std::to_string(i) + " (ID " + std::to_string(t.id) + ") has a non-finite " + bad);
+			}
+		}
+		else if (const auto* b = dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&o))
+		{
+			for (std::size_t i = 0; i < b->sensedData.size(); ++i)
+			{
+				const auto& m = b->sensedData[i];
+				const bool ok = std::isfinite(m.range) && std::isfinite(m.yaw) && std::isfinite(m.pitch) &&
+					(!b->validCovariances || m.covariance.asEigen().allFinite());
+				if (!ok)
+					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): reading #" +
+						std::to_string(i) + " (landmark ID " + std::to_string(m.landmarkID) +
+						") has a non-finite range, yaw, pitch or covariance");
+			}
+		}
+	}
+
 	void emit(const Frame& f, const mrpt::obs::CActionRobotMovement2D::Ptr& odo)
 	{
 		RawlogStep s;
@@ -313,6 +358,7 @@ struct RawlogStepper::Impl
 			if (dynamic_cast<const CObservationCodedLandmarks*>(o.get())) annotated.push_back(o->sensorLabel);
 		for (const auto& o : f.obs)
 		{
+			checkFinite(*o, f.entry);
 			if (auto img = std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(o))
 			{
 				if (!opt.detect_images) continue;
