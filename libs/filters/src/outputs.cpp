@@ -317,6 +317,7 @@ std::string summaryJson(const LocalizeSummary& s)
 	o << "  \"sightings_used\": " << s.sightings_used << ",\n";
 	o << "  \"sightings_rejected\": " << s.sightings_rejected << ",\n";
 	o << "  \"sightings_unknown_id\": " << s.sightings_unknown_id << ",\n";
+	o << "  \"sightings_too_oblique\": " << s.sightings_too_oblique << ",\n";
 	o << "  \"reinitializations\": " << s.reinitializations << ",\n";
 	o << "  \"first_fix_step\": " << s.first_fix_step << ",\n";
 	o << "  \"first_fix_time_s\": " << num(s.first_fix_time_s, 3) << ",\n";
@@ -425,6 +426,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		s.sightings_used += st.used;
 		s.sightings_rejected += st.rejected;
 		s.sightings_unknown_id += st.unknown_id;
+		s.sightings_too_oblique += step.sightings_too_oblique;
 		s.reinitializations += st.reinitialized ? 1 : 0;
 		s.rows.push_back(std::move(row));
 		++s.steps;

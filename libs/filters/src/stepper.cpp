@@ -53,6 +53,9 @@ void StepperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	motion.thrunModel.additional_std_phi =
 		c.read_float(s, "thrunModel.additional_std_phi", motion.thrunModel.additional_std_phi);
 	MRPT_LOAD_CONFIG_VAR(detect_images, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(max_view_angle_deg, double, c, s);
+	if (!(max_view_angle_deg > 0))
+		throw std::invalid_argument("[" + s + "] max_view_angle_deg must be > 0 [deg]");
 }
 
 void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
@@ -67,6 +70,7 @@ void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "gaussianModel.minStdXY", motion.gaussianModel.minStdXY, -1, -1);
 	c.write(s, "gaussianModel.minStdPHI", motion.gaussianModel.minStdPHI, -1, -1);
 	c.write(s, "detect_images", detect_images, -1, -1);
+	c.write(s, "max_view_angle_deg", max_view_angle_deg, -1, -1);
 }
 
 CPose2D interpolatePose(double t0, const CPose2D& p0, double t1, const CPose2D& p1, double t)
@@ -378,7 +382,38 @@ struct RawlogStepper::Impl
 			else
 				s.observations.insert(o);
 		}
+		dropOblique(s);
 		ready.push_back(std::move(s));
+	}
+
+	// Replaces coded observations that hold sightings beyond
+	// max_view_angle_deg by copies without them.
+	void dropOblique(RawlogStep& s) const
+	{
+		if (opt.max_view_angle_deg >= 90.0) return;
+		const double max_rad = opt.max_view_angle_deg * M_PI / 180.0;
+		auto oblique = [&](const CObservationCodedLandmarks::TSighting& t)
+		{ return std::abs(mrpt::math::wrapToPi(t.L[1] + t.L[2])) > max_rad; };
+		mrpt::obs::CSensoryFrame out;
+		bool changed = false;
+		for (const auto& o : s.observations)
+		{
+			const auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o);
+			if (!c || std::none_of(c->sightings.begin(), c->sightings.end(), oblique))
+			{
+				out.insert(o);
+				continue;
+			}
+			auto copy = std::make_shared<CObservationCodedLandmarks>(*c);
+			const auto n = copy->sightings.size();
+			copy->sightings.erase(
+				std::remove_if(copy->sightings.begin(), copy->sightings.end(), oblique),
+				copy->sightings.end());
+			s.sightings_too_oblique += static_cast<int>(n - copy->sightings.size());
+			out.insert(copy);
+			changed = true;
+		}
+		if (changed) s.observations = std::move(out);
 	}
 };
 

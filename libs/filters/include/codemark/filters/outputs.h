@@ -78,6 +78,9 @@ struct LocalizeSummary
 	std::string method;
 	long steps = 0;  //!< processed camera frames
 	long sightings_used = 0, sightings_rejected = 0, sightings_unknown_id = 0;
+	/** Coded sightings dropped before the filter as seen beyond
+	 * [stepper] max_view_angle_deg (not in sightings_rejected). */
+	long sightings_too_oblique = 0;
 	long reinitializations = 0;  //!< global initialisation and kidnap recoveries
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
