@@ -34,15 +34,16 @@ LocalizeSummary runOn(
 }
 
 // Known shortfall (docs/benchmarks/filters.md): on this dataset (seed 3)
-// the targets are not met. ATE about 4 cm against 3 cm, and the mean
-// NEES (ekf about 15, observations-only about 80; ekf-pose about 1.9) is
-// outside the 95% band: the global initialisation from one landmark 4 m
-// away (phi2 good to ~13 deg) leaves a nearly singular, strongly correlated
-// covariance whose thin direction the next sightings' linearisation errors
-// exceed (per-axis normalised errors stay below 1). The measurements
-// themselves are conservative (mean d2 2.3 against 3 on the demo dataset).
+// the ATE is about 4 cm (5 cm observations-only) against the 3 cm:
+// the first fix, from one landmark 4 m away whose phi2 is good to ~13 deg,
+// is 24 cm off (inside its covariance), which alone adds 2.2 cm to the RMS.
+// The mean NEES is about 1.9 (1.6 observations-only), below the 95% band:
+// the pipeline's calibrated C_L is conservative on these renders (phi2's
+// normalised squared error averages about 0.1, the whole L's d2 about 2.5
+// against 3); the filters pass that on honestly rather than rescale it.
 // \a nees_factor widens the band by a factor on both sides, so the test
-// still fails on divergence or on covariances inflated to pass.
+// still fails on overconfidence (the plain EKF's one linearisation gave 15)
+// or on covariances inflated further.
 void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_factor)
 {
 	ASSERT_TRUE(s.metrics);
@@ -62,14 +63,14 @@ void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_fa
 
 TEST(FiltersSim, EkfAndEkfPoseFullLoopActionsObservations)
 {
-	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.05, 6.0);
-	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.05, 1.5);
+	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.045, 1.6);
+	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.045, 1.6);
 }
 
 TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 {
 	// Odometry noise drawn per 20 Hz reading, interpolated to 5 Hz images.
-	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.08, 25.0);
+	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.06, 1.7);
 }
 
 // EKF-SLAM from scratch (no map) on the rendered loop: almost nothing gated,

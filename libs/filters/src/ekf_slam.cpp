@@ -367,47 +367,53 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 		return t_of[p];
 	}
 
-	// Wraps the yaws, symmetrises P and checks it, in O(n^2) (a full
-	// eigen-decomposition every iteration would cost O(n^3)): every entry
-	// finite, every diagonal entry >= -pd_tolerance (one in [-tol, 0] is
-	// raised to 0), every 2x2 principal minor non-negative within the
-	// tolerance (|P_ij| <= sqrt(P_ii P_jj) + tol), and the robot's block and
-	// each landmark's block positive semi-definite (eigenvalues >= -tol *
-	// max(1, largest)). Anything else stops the run with an error.
+	// After every prediction and update (OnNormalizeStateVector), O(n):
+	// wraps the yaws, checks that the state and P's diagonal are finite and
+	// the diagonal >= -pd_tolerance (one in [-tol, 0] is raised to 0).
 	void normalize()
 	{
 		m_xkk[2] = wrapToPi(m_xkk[2]);
 		if (D == 3)
 			for (std::size_t i = 5; i < static_cast<std::size_t>(m_xkk.size()); i += 3)
 				m_xkk[i] = wrapToPi(m_xkk[i]);
-		for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(m_xkk.size()); ++i)
+		auto P = m_pkk.asEigen();
+		for (Eigen::Index i = 0; i < P.rows(); ++i)
+		{
 			if (!std::isfinite(m_xkk[i]))
 				throw std::runtime_error(
 					"ekf-slam: the state became non-finite (entry " + std::to_string(i) + ")");
+			if (!std::isfinite(P(i, i)) || P(i, i) < -opts.pd_tolerance)
+				throw std::runtime_error(
+					"ekf-slam: the covariance is no longer symmetric positive definite (diagonal " +
+					std::to_string(i) + " = " + std::to_string(P(i, i)) + ")");
+			if (P(i, i) < 0) P(i, i) = 0;
+		}
+	}
+
+	// Once per step, O(n^2) (a full eigen-decomposition would cost O(n^3)):
+	// symmetrises P (MRPT's full update (I-KH)P is not symmetric) and checks
+	// every entry finite, every 2x2 principal minor non-negative within the
+	// tolerance (P_ij^2 <= P_ii P_jj (1 + 1e-6) + tol), and the robot's block
+	// and each landmark's block positive semi-definite (eigenvalues >= -tol
+	// max(1, largest)). Anything else stops the run with an error.
+	void checkCovariance()
+	{
 		auto P = m_pkk.asEigen();
-		const Eigen::Index n = P.rows();
 		const double tol = opts.pd_tolerance;
 		auto fail = [&](const std::string& what)
 		{
 			throw std::runtime_error(
 				"ekf-slam: the covariance is no longer symmetric positive definite (" + what + ")");
 		};
-		for (Eigen::Index r = 0; r < n; ++r)
-		{
-			if (!std::isfinite(P(r, r)) || P(r, r) < -tol)
-				fail("diagonal " + std::to_string(r) + " = " + std::to_string(P(r, r)));
-			if (P(r, r) < 0) P(r, r) = 0;
-		}
-		for (Eigen::Index r = 0; r < n; ++r)
-			for (Eigen::Index c = r + 1; c < n; ++c)
-			{
-				const double m = 0.5 * (P(r, c) + P(c, r));
-				if (!std::isfinite(m) || std::abs(m) > std::sqrt(P(r, r) * P(c, c)) * (1 + 1e-6) + tol)
-					fail("entry (" + std::to_string(r) + ", " + std::to_string(c) + ") = " +
-						std::to_string(m) + " exceeds its 2x2 principal minor");
-				P(r, c) = m;
-				P(c, r) = m;
-			}
+		P = 0.5 * (P + P.transpose()).eval();
+		if (!P.allFinite()) fail("non-finite entries");
+		const Eigen::VectorXd d = P.diagonal();
+		const Eigen::MatrixXd excess =
+			P.cwiseAbs2() - (d * d.transpose()) * (1.0 + 1e-6) - Eigen::MatrixXd::Constant(P.rows(), P.cols(), tol);
+		Eigen::Index r = 0, c = 0;
+		if (excess.maxCoeff(&r, &c) > 0)
+			fail("entry (" + std::to_string(r) + ", " + std::to_string(c) + ") = " + std::to_string(P(r, c)) +
+				" exceeds its 2x2 principal minor");
 		auto checkBlock = [&](const auto& B, Eigen::Index o)
 		{
 			using M = std::decay_t<decltype(B)>;
@@ -417,7 +423,7 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 					" block has eigenvalue " + std::to_string(ev.minCoeff()));
 		};
 		checkBlock(Eigen::Matrix3d(P.template block<3, 3>(0, 0)), 0);
-		for (Eigen::Index o = 3; o + static_cast<Eigen::Index>(D) <= n; o += D)
+		for (Eigen::Index o = 3; o + static_cast<Eigen::Index>(D) <= P.rows(); o += D)
 			checkBlock(MatD(P.template block<D, D>(o, o)), o);
 	}
 
@@ -882,6 +888,7 @@ class EkfSlam::Impl
 			kf.iterate();
 		}
 		kf.pass.clear();
+		kf.checkCovariance();
 		st.used += kf.used;
 		st.rejected += kf.rejected;
 		return st;
