@@ -315,3 +315,21 @@ TEST(Ekf, IteratedUpdateIsConsistentFromAWidePrior)
 	EXPECT_LT(mean_nees[1], 4.0);
 	EXPECT_GT(mean_nees[0], 5 * mean_nees[1]) << "the plain EKF should be clearly overconfident here";
 }
+
+// A map with no landmarks cannot localise anything: a clear error at
+// construction rather than a run that silently never fixes.
+TEST(EkfFactory, EmptyMapIsAnError)
+{
+	for (const auto kind : {EkfMeasurement::Landmark, EkfMeasurement::PoseFix})
+	{
+		try
+		{
+			makeEkfLocalizer(kind, EkfOptions(), LandmarkMap{});
+			FAIL() << "an empty map must throw";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find("map is empty"), std::string::npos) << e.what();
+		}
+	}
+}

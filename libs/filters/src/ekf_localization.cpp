@@ -156,6 +156,10 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		: kind_(kind), opt_(o), map_(map), gate_(mrpt::math::chi2inv(o.gate_probability, 3))
 	{
 		opt_.validate();
+		if (map_.landmarks.empty())
+			throw std::invalid_argument(
+				std::string("method '") + (kind == EkfMeasurement::Landmark ? "ekf" : "ekf-pose") +
+				"': the landmark map is empty");
 		setMinLoggingLevel(mrpt::system::LVL_ERROR);
 		KF_options.method = mrpt::bayes::kfEKFNaive;
 		KF_options.use_analytic_observation_jacobian = true;  // required with FEAT = 0

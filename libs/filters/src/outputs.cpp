@@ -380,6 +380,9 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 	if (!req.map_file.empty()) map = loadAnyMap(req.map_file);
 	else if (!slam)
 		throw std::invalid_argument("method '" + s.method + "' needs a landmark map (--map)");
+	if (!slam && map.landmarks.empty())
+		throw std::invalid_argument(
+			req.map_file + ": the map has no landmarks (method '" + s.method + "' needs at least one)");
 	std::optional<GroundTruth> gt;
 	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
 
