@@ -56,6 +56,9 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> gt("g", "gt",
 			"ground truth: 'timestamp x y yaw' rows (matched by timestamp) or an MRPT robot path "
 			"'x y z yaw pitch roll' (step i = row i + 1)", false, "", "GT.txt", cmd);
+		TCLAP::ValueArg<std::string> gt_map("", "gt-map",
+			"ekf-slam: the true landmark map (spec section 3 or MRPT's x y z type 0 0 id) for the "
+			"landmark RMSE in summary.json", false, "", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> out("o", "out", "output directory (created)", true, "", "DIR", cmd);
 		TCLAP::SwitchArg gui("", "gui", "live view (not available in this build: prints a note and runs without)", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
@@ -70,6 +73,7 @@ int main(int argc, char** argv)
 		req.map_file = map.getValue();
 		req.method = method.getValue();
 		req.gt_file = gt.getValue();
+		req.gt_map_file = gt_map.getValue();
 		req.out_dir = out.getValue();
 		codemark::app::ProgressBar bar("codemark-localize", !quiet.getValue());
 		const auto s = codemark::filters::runLocalization(
@@ -80,7 +84,8 @@ int main(int argc, char** argv)
 				  << s.sightings_unknown_id << " unknown IDs, " << s.time_per_step_ms << " ms/step";
 		if (s.metrics)
 			std::cout << "; ATE " << s.metrics->ate_rmse_m << " m, yaw RMSE " << s.metrics->yaw_rmse_deg
-					  << " deg, mean NEES " << s.metrics->nees_mean;
+					  << " deg, mean NEES " << s.metrics->nees_mean
+					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth)" : "");
 		std::cout << "; wrote " << req.out_dir << "\n";
 		return 0;
 	}

@@ -174,3 +174,36 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 		EXPECT_NE(std::string(e.what()).find("badmap.txt"), std::string::npos) << e.what();
 	}
 }
+
+// SLAM's frame is its own start: the metrics align it to the truth (SE(2)
+// least squares). A rotated and shifted copy of the truth has zero error
+// after alignment, and the recovered transform is the inverse shift.
+TEST(Metrics, AlignSE2RecoversARigidTransform)
+{
+	const CPose2D truth_T_est(1.5, -0.7, 0.4);
+	std::vector<PathRow> rows(20);
+	for (std::size_t i = 0; i < rows.size(); ++i)
+	{
+		const double a = 0.3 * static_cast<double>(i);
+		const CPose2D truth(2 * std::cos(a), std::sin(a), a + 0.1);
+		rows[i].truth = truth;
+		rows[i].estimate.initialized = true;
+		rows[i].estimate.mean = CPose2D() - truth_T_est + truth;
+		rows[i].estimate.cov = Eigen::Matrix3d::Identity() * 1e-4;
+	}
+	const auto plain = computeMetrics(rows);
+	ASSERT_TRUE(plain);
+	EXPECT_GT(plain->ate_rmse_m, 0.5);
+	const auto m = computeMetrics(rows, true);
+	ASSERT_TRUE(m);
+	EXPECT_TRUE(m->aligned);
+	EXPECT_LT(m->ate_rmse_m, 1e-9);
+	EXPECT_LT(m->yaw_rmse_deg, 1e-7);
+	EXPECT_NEAR(m->truth_T_estimate.x(), truth_T_est.x(), 1e-9);
+	EXPECT_NEAR(m->truth_T_estimate.y(), truth_T_est.y(), 1e-9);
+	EXPECT_NEAR(m->truth_T_estimate.phi(), truth_T_est.phi(), 1e-9);
+	LocalizeSummary ls;
+	ls.method = "ekf-slam";
+	ls.metrics = m;
+	EXPECT_NE(summaryJson(ls).find("\"alignment\": \"se2_least_squares\""), std::string::npos);
+}

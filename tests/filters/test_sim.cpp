@@ -14,7 +14,8 @@ using namespace codemark::filters;
 
 namespace
 {
-LocalizeSummary runOn(bool obs_only, int max_frames, const std::string& method, const std::string& ini)
+LocalizeSummary runOn(
+	bool obs_only, int max_frames, const std::string& method, const std::string& ini, bool slam_no_map = false)
 {
 	sim::DatasetOptions o;
 	o.odometry_scale_error = 0.03;
@@ -25,16 +26,24 @@ LocalizeSummary runOn(bool obs_only, int max_frames, const std::string& method, 
 	LocalizeRequest req;
 	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/" + ini;
 	req.rawlog = (dir / "dataset.rawlog").string();
-	req.map_file = (dir / "map.txt").string();
+	req.map_file = slam_no_map ? "" : (dir / "map.txt").string();
+	if (slam_no_map) req.gt_map_file = (dir / "map.txt").string();
 	req.gt_file = (dir / "gt_path.txt").string();
 	req.method = method;
 	return runLocalization(req);
 }
 
-// Known shortfall (see the report in docs/benchmarks/filters.md): with
-// codemark-simul's default odometry noise (MRPT's Gaussian model defaults,
-// 1 cm per step) the 3 cm ATE target is not met (about 4 cm), and
-// the mean NEES is only near the 95% band; \a nees_factor widens the band.
+// Known shortfall (docs/benchmarks/filters.md): on this dataset (seed 3)
+// the ATE is about 4 cm (5 cm observations-only) against the 3 cm:
+// the first fix, from one landmark 4 m away whose phi2 is good to ~13 deg,
+// is 24 cm off (inside its covariance), which alone adds 2.2 cm to the RMS.
+// The mean NEES is about 1.9 (1.6 observations-only), below the 95% band:
+// the pipeline's calibrated C_L is conservative on these renders (phi2's
+// normalised squared error averages about 0.1, the whole L's d2 about 2.5
+// against 3); the filters pass that on honestly rather than rescale it.
+// \a nees_factor widens the band by a factor on both sides, so the test
+// still fails on overconfidence (the plain EKF's one linearisation gave 15)
+// or on covariances inflated further.
 void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_factor)
 {
 	ASSERT_TRUE(s.metrics);
@@ -54,12 +63,32 @@ void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_fa
 
 TEST(FiltersSim, EkfAndEkfPoseFullLoopActionsObservations)
 {
-	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.05, 1.2);
-	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.05, 1.2);
+	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.045, 1.6);
+	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.045, 1.6);
 }
 
 TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 {
 	// Odometry noise drawn per 20 Hz reading, interpolated to 5 Hz images.
-	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.08, 2.5);
+	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.06, 1.7);
+}
+
+// EKF-SLAM from scratch (no map) on the rendered loop: almost nothing gated,
+// landmark yaws and positions close to the truth after the SE(2) alignment
+// (they used to drift by hundreds of degrees with most sightings gated).
+TEST(FiltersSim, EkfSlamMapsTheRoomWithSmallLandmarkYawErrors)
+{
+	const LocalizeSummary s = runOn(false, 0, "ekf-slam", "ekf-slam.ini", true);
+	ASSERT_TRUE(s.metrics);
+	const auto& m = *s.metrics;
+	EXPECT_TRUE(m.aligned);
+	EXPECT_LE(s.sightings_rejected, s.sightings_used / 50) << "at most 2% gated";
+	EXPECT_GE(m.landmarks_matched, 6);
+	EXPECT_LT(m.landmark_yaw_rmse_deg, 2.0);
+	EXPECT_LT(m.landmark_rmse_m, 0.08);
+	EXPECT_LT(m.ate_rmse_m, 0.08);
+	std::cout << "ekf-slam: ATE " << m.ate_rmse_m << " m (aligned), NEES " << m.nees_mean << ", landmarks "
+			  << m.landmarks_matched << ", landmark RMSE " << m.landmark_rmse_m << " m, yaw RMSE "
+			  << m.landmark_yaw_rmse_deg << " deg, used " << s.sightings_used << ", rejected "
+			  << s.sightings_rejected << "\n";
 }

@@ -236,3 +236,79 @@ TEST(Stepper, CorruptEntryNamesItsIndexAndNoTimestampsGiveStepIndices)
 	}
 	EXPECT_THROW(RawlogStepper(tempFile("missing.rawlog")), std::runtime_error);
 }
+
+// NaN or inf in odometry or in a sighting: an error naming the entry and
+// what is wrong, never a silently wrong estimate.
+TEST(Stepper, NonFiniteOdometryAndSightingsNameTheEntry)
+{
+	auto expectError = [](const std::string& path, const std::string& what, long entry)
+	{
+		RawlogStepper st(path);
+		RawlogStep s;
+		try
+		{
+			while (st.next(s))
+			{
+			}
+			FAIL() << path << ": must throw";
+		}
+		catch (const std::runtime_error& e)
+		{
+			const std::string m = e.what();
+			EXPECT_NE(m.find("entry #" + std::to_string(entry)), std::string::npos) << m;
+			EXPECT_NE(m.find(what), std::string::npos) << m;
+		}
+	};
+	auto bad_odo = odoAt(0.2);
+	bad_odo->odometry = CPose2D(std::nan(""), 0, 0);
+	const std::string p1 = tempFile("nan_odometry.rawlog");
+	writeRawlog(p1, {odoAt(0), landmarksAt(kT0 + 0.1), bad_odo});
+	expectError(p1, "not finite", 2);
+
+	auto lm = landmarksAt(kT0 + 0.1);
+	CObservationCodedLandmarks::TSighting t;
+	t.id = 4;
+	t.L = Eigen::Vector3d(2.0, std::numeric_limits<double>::infinity(), 0.0);
+	t.C_L = Eigen::Matrix3d::Identity() * 1e-4;
+	lm->sightings.push_back(t);
+	const std::string p2 = tempFile("inf_sighting.rawlog");
+	writeRawlog(p2, {landmarksAt(kT0), lm});
+	expectError(p2, "non-finite L", 1);
+}
+
+// Sightings seen beyond max_view_angle_deg from the landmark's normal are
+// dropped and counted; the others pass.
+TEST(Stepper, DropsObliqueSightings)
+{
+	auto lm = landmarksAt(kT0);
+	CObservationCodedLandmarks::TSighting t;
+	t.C_L = Eigen::Matrix3d::Identity() * 1e-4;
+	t.id = 1, t.L = Eigen::Vector3d(2.0, 0.2, 0.5);  // 40 deg: kept
+	lm->sightings.push_back(t);
+	t.id = 2, t.L = Eigen::Vector3d(2.0, -0.3, -1.0);  // 74 deg: dropped
+	lm->sightings.push_back(t);
+	const std::string path = tempFile("oblique.rawlog");
+	writeRawlog(path, {lm});
+	for (const double max_deg : {60.0, 90.0})
+	{
+		StepperOptions o;
+		o.max_view_angle_deg = max_deg;
+		RawlogStepper st(path, o);
+		RawlogStep s;
+		ASSERT_TRUE(st.next(s));
+		std::vector<int> ids;
+		for (const auto& obs : s.observations)
+			if (const auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(obs))
+				for (const auto& x : c->sightings) ids.push_back(x.id);
+		if (max_deg < 90)
+		{
+			EXPECT_EQ(ids, std::vector<int>({1}));
+			EXPECT_EQ(s.sightings_too_oblique, 1);
+		}
+		else
+		{
+			EXPECT_EQ(ids, std::vector<int>({1, 2}));
+			EXPECT_EQ(s.sightings_too_oblique, 0);
+		}
+	}
+}

@@ -251,6 +251,8 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 	// Per Kalman iteration.
 	std::vector<Sighting> pass;  //!< this iteration's sightings, one per landmark at most
 	std::vector<int> sighting_of;  //!< landmark index -> index in pass, or -1
+	mutable std::vector<MatD> t_of;  //!< per pass index: transform(), once computed
+	mutable std::vector<bool> t_ready;  //!< per pass index: t_of is computed
 	bool skip_prediction = false;
 	mrpt::poses::CPose2D odo_mean;  //!< odometry increment in the robot frame
 	Eigen::Matrix3d odo_cov = Eigen::Matrix3d::Zero();
@@ -275,6 +277,8 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 				sighting_of[it->second] = static_cast<int>(i);
 		new_queue.clear();
 		new_cursor = 0;
+		t_of.assign(pass.size(), MatD::Identity());
+		t_ready.assign(pass.size(), false);
 		this->runOneKalmanIteration();
 		++iterations;
 	}
@@ -316,7 +320,56 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 
 	MatD whitening(const Sighting& s) const { return s.W.topLeftCorner<D, D>(); }
 
-	// Wraps the yaws, symmetrises P and checks its diagonal.
+	/** The predicted observation of a sighting with its angle components
+	 * unwrapped to within pi of the measured ones, so that z - h is the
+	 * wrapped innovation whatever linear transform is applied to both. */
+	VecD predictNear(const Sighting& s, std::size_t idx, MatDx3* Hx, MatD* Hy) const
+	{
+		VecD h = predict(s, idx, Hx, Hy);
+		for (std::size_t k = 1; k < D; ++k) h[k] = s.z[k] - wrapToPi(s.z[k] - h[k]);
+		return h;
+	}
+
+	/** The transform T applied to the sighting of landmark \a idx (pass
+	 * index \a p), computed once per Kalman iteration, after the prediction
+	 * stage, from the predicted covariance: T = V^T W with W = chol(C)^-1
+	 * and V the eigenvectors of W H P H^T W^T + I. Then T C T^T = I (MRPT's
+	 * single R) and T S T^T is diagonal: the scalar components of the
+	 * transformed innovation are uncorrelated. That is what makes MRPT's
+	 * scalar-at-once update (kfEKFAlaDavison) exact: it processes the
+	 * components one after the other with the innovations computed once,
+	 * before the first of them, which is only right when updating with one
+	 * component does not change the prediction of the next (H_j P H_i^T =
+	 * 0). With W alone, the correlated components of L (and the landmark
+	 * yaw seen only through phi2) were fused as if independent: the
+	 * landmark yaws diverged. Any invertible T leaves the full update
+	 * (kfEKFNaive) unchanged. */
+	const MatD& transform(std::size_t p, std::size_t idx) const
+	{
+		if (t_ready[p]) return t_of[p];
+		MatDx3 hx;
+		MatD hy;
+		predict(pass[p], idx, &hx, &hy);
+		const MatD W = whitening(pass[p]);
+		Eigen::Matrix<double, D, 3 + D> H;
+		H << W * hx, W * hy;
+		const auto P = m_pkk.asEigen();
+		const Eigen::Index o = 3 + D * static_cast<Eigen::Index>(idx);
+		Eigen::Matrix<double, 3 + D, 3 + D> Pb;
+		Pb.template topLeftCorner<3, 3>() = P.template block<3, 3>(0, 0);
+		Pb.template topRightCorner<3, D>() = P.template block<3, D>(0, o);
+		Pb.template bottomLeftCorner<D, 3>() = P.template block<D, 3>(o, 0);
+		Pb.template bottomRightCorner<D, D>() = P.template block<D, D>(o, o);
+		const MatD S = H * Pb * H.transpose() + MatD::Identity();
+		const Eigen::SelfAdjointEigenSolver<MatD> eig(0.5 * (S + S.transpose()));
+		t_of[p] = eig.eigenvectors().transpose() * W;
+		t_ready[p] = true;
+		return t_of[p];
+	}
+
+	// After every prediction and update (OnNormalizeStateVector), O(n):
+	// wraps the yaws, checks that the state and P's diagonal are finite and
+	// the diagonal >= -pd_tolerance (one in [-tol, 0] is raised to 0).
 	void normalize()
 	{
 		m_xkk[2] = wrapToPi(m_xkk[2]);
@@ -324,21 +377,54 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 			for (std::size_t i = 5; i < static_cast<std::size_t>(m_xkk.size()); i += 3)
 				m_xkk[i] = wrapToPi(m_xkk[i]);
 		auto P = m_pkk.asEigen();
-		const Eigen::Index n = P.rows();
-		for (Eigen::Index r = 0; r < n; ++r)
+		for (Eigen::Index i = 0; i < P.rows(); ++i)
 		{
-			for (Eigen::Index c = r + 1; c < n; ++c)
-			{
-				const double m = 0.5 * (P(r, c) + P(c, r));
-				P(r, c) = m;
-				P(c, r) = m;
-			}
-			if (!std::isfinite(P(r, r)) || P(r, r) < -opts.pd_tolerance)
+			if (!std::isfinite(m_xkk[i]))
 				throw std::runtime_error(
-					"ekf-slam: covariance lost positive definiteness (diagonal " +
-					std::to_string(r) + " = " + std::to_string(P(r, r)) + ")");
-			if (P(r, r) < 0) P(r, r) = 0;
+					"ekf-slam: the state became non-finite (entry " + std::to_string(i) + ")");
+			if (!std::isfinite(P(i, i)) || P(i, i) < -opts.pd_tolerance)
+				throw std::runtime_error(
+					"ekf-slam: the covariance is no longer symmetric positive definite (diagonal " +
+					std::to_string(i) + " = " + std::to_string(P(i, i)) + ")");
+			if (P(i, i) < 0) P(i, i) = 0;
 		}
+	}
+
+	// Once per step, O(n^2) (a full eigen-decomposition would cost O(n^3)):
+	// symmetrises P (MRPT's full update (I-KH)P is not symmetric) and checks
+	// every entry finite, every 2x2 principal minor non-negative within the
+	// tolerance (P_ij^2 <= P_ii P_jj (1 + 1e-6) + tol), and the robot's block
+	// and each landmark's block positive semi-definite (eigenvalues >= -tol
+	// max(1, largest)). Anything else stops the run with an error.
+	void checkCovariance()
+	{
+		auto P = m_pkk.asEigen();
+		const double tol = opts.pd_tolerance;
+		auto fail = [&](const std::string& what)
+		{
+			throw std::runtime_error(
+				"ekf-slam: the covariance is no longer symmetric positive definite (" + what + ")");
+		};
+		P = 0.5 * (P + P.transpose()).eval();
+		if (!P.allFinite()) fail("non-finite entries");
+		const Eigen::VectorXd d = P.diagonal();
+		const Eigen::MatrixXd excess =
+			P.cwiseAbs2() - (d * d.transpose()) * (1.0 + 1e-6) - Eigen::MatrixXd::Constant(P.rows(), P.cols(), tol);
+		Eigen::Index r = 0, c = 0;
+		if (excess.maxCoeff(&r, &c) > 0)
+			fail("entry (" + std::to_string(r) + ", " + std::to_string(c) + ") = " + std::to_string(P(r, c)) +
+				" exceeds its 2x2 principal minor");
+		auto checkBlock = [&](const auto& B, Eigen::Index o)
+		{
+			using M = std::decay_t<decltype(B)>;
+			const auto ev = Eigen::SelfAdjointEigenSolver<M>(B, Eigen::EigenvaluesOnly).eigenvalues();
+			if (ev.minCoeff() < -tol * std::max(1.0, ev.maxCoeff()))
+				fail((o == 0 ? std::string("robot") : "landmark " + std::to_string((o - 3) / D)) +
+					" block has eigenvalue " + std::to_string(ev.minCoeff()));
+		};
+		checkBlock(Eigen::Matrix3d(P.template block<3, 3>(0, 0)), 0);
+		for (Eigen::Index o = 3; o + static_cast<Eigen::Index>(D) <= P.rows(); o += D)
+			checkBlock(MatD(P.template block<D, D>(o, o)), o);
 	}
 
 	void addHeight(std::size_t idx, const Sighting& s)
@@ -410,8 +496,8 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 				out[k].setZero();  // not sighted: never used, not computed
 				continue;
 			}
-			const Sighting& s = pass[sighting_of[idx]];
-			out[k].asEigen() = whitening(s) * predict(s, idx, nullptr, nullptr);
+			const std::size_t p = static_cast<std::size_t>(sighting_of[idx]);
+			out[k].asEigen() = transform(p, idx) * predictNear(pass[p], idx, nullptr, nullptr);
 		}
 	}
 
@@ -423,12 +509,13 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 			Hy.setZero();
 			return;
 		}
-		const Sighting& s = pass[sighting_of[idx]];
+		const std::size_t p = static_cast<std::size_t>(sighting_of[idx]);
 		MatDx3 hx;
 		MatD hy;
-		predict(s, idx, &hx, &hy);
-		Hx.asEigen() = whitening(s) * hx;
-		Hy.asEigen() = whitening(s) * hy;
+		predict(pass[p], idx, &hx, &hy);
+		const MatD& T = transform(p, idx);
+		Hx.asEigen() = T * hx;
+		Hy.asEigen() = T * hy;
 	}
 
 	void OnGetObservationsAndDataAssociation(
@@ -453,11 +540,9 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 				continue;
 			}
 			const std::size_t idx = it->second;
-			const VecD h = predict(s, idx, nullptr, nullptr);
-			VecD nu = z - h;
-			nu[1] = wrapToPi(nu[1]);
-			if (D == 3) nu[D - 1] = s.point ? 0.0 : wrapToPi(nu[D - 1]);
-			const VecD w = whitening(s) * nu;
+			const VecD nu = z - predictNear(s, idx, nullptr, nullptr);  // wrapped
+			const MatD& T = transform(i, idx);
+			const VecD w = T * nu;
 			std::size_t k = 0;
 			while (k < in_idx_S.size() && in_idx_S[k] != idx) ++k;
 			if (k == in_idx_S.size()) throw std::logic_error("ekf-slam: sighted landmark not predicted");
@@ -468,9 +553,10 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 				++rejected;
 				continue;
 			}
-			// MRPT's innovation is out_z - W h = W nu: the wrapped innovation.
+			// MRPT's innovation is out_z - T h = T nu (h from predictNear()):
+			// the wrapped innovation, transformed.
 			KFArray_OBS zz;
-			zz.asEigen() = whitening(s) * (h + nu);
+			zz.asEigen() = T * z;
 			out_z.push_back(zz);
 			out_da.push_back(static_cast<int>(idx));
 			++used;
@@ -765,16 +851,35 @@ class EkfSlam::Impl
 			kf.odo_mean = mrpt::poses::CPose2D();  // the fix is at this frame
 			kf.odo_cov.setZero();
 		}
-		// Pass k holds the k-th sighting of each ID in this frame: one
-		// observation per landmark per Kalman iteration (the whitening is per
-		// landmark); later passes skip the prediction.
-		std::map<int, int> seen;
+		// One Kalman iteration per pass; later passes skip the prediction.
+		// The full update (kfEKFNaive): pass k holds the k-th sighting of each
+		// ID in this frame (one observation per landmark per iteration, the
+		// transform is per landmark). The scalar-at-once update: one sighting
+		// of a mapped landmark per pass, since SlamKF::transform() decorrelates
+		// the components of one sighting given the covariance before its
+		// update; new landmarks share the first pass.
 		std::vector<std::vector<Sighting>> passes(1);
-		for (auto& s : all)
+		if (kf.KF_options.method == mrpt::bayes::kfEKFAlaDavison)
 		{
-			const int k = seen[s.id]++;
-			if (static_cast<int>(passes.size()) <= k) passes.resize(k + 1);
-			passes[k].push_back(std::move(s));
+			std::map<int, int> seen;
+			for (auto& s : all)
+			{
+				const bool fresh = !kf.id_to_idx.count(s.id) && seen[s.id]++ == 0;
+				if (fresh) passes.front().push_back(std::move(s));
+				else
+					passes.push_back({std::move(s)});
+			}
+			if (passes.size() > 1 && passes.front().empty()) passes.erase(passes.begin());
+		}
+		else
+		{
+			std::map<int, int> seen;
+			for (auto& s : all)
+			{
+				const int k = seen[s.id]++;
+				if (static_cast<int>(passes.size()) <= k) passes.resize(k + 1);
+				passes[k].push_back(std::move(s));
+			}
 		}
 		for (std::size_t p = 0; p < passes.size(); ++p)
 		{
@@ -783,6 +888,7 @@ class EkfSlam::Impl
 			kf.iterate();
 		}
 		kf.pass.clear();
+		kf.checkCovariance();
 		st.used += kf.used;
 		st.rejected += kf.rejected;
 		return st;

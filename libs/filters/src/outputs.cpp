@@ -13,6 +13,7 @@
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/opengl/CText.h>
+#include <mrpt/poses/CPoint2D.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <Eigen/Dense>
@@ -31,21 +32,73 @@ namespace codemark::filters
 namespace fs = std::filesystem;
 using mrpt::poses::CPose2D;
 
-std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows)
+mrpt::poses::CPose2D alignSE2(
+	const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b)
+{
+	if (a.empty() || a.size() != b.size())
+		throw std::invalid_argument("alignSE2: needs as many points in both sets, at least one");
+	Eigen::Vector2d ma = Eigen::Vector2d::Zero(), mb = Eigen::Vector2d::Zero();
+	for (std::size_t i = 0; i < a.size(); ++i) ma += a[i], mb += b[i];
+	ma /= static_cast<double>(a.size());
+	mb /= static_cast<double>(b.size());
+	// The rotation maximising sum (b_i - mb) . R (a_i - ma): atan2 of the
+	// cross and dot sums (the 2D case of Umeyama's SVD).
+	double sdot = 0, scross = 0;
+	for (std::size_t i = 0; i < a.size(); ++i)
+	{
+		const Eigen::Vector2d p = a[i] - ma, q = b[i] - mb;
+		sdot += p.dot(q);
+		scross += p.x() * q.y() - p.y() * q.x();
+	}
+	const double th = (sdot == 0 && scross == 0) ? 0.0 : std::atan2(scross, sdot);
+	const Eigen::Rotation2Dd R(th);
+	const Eigen::Vector2d t = mb - R * ma;
+	return mrpt::poses::CPose2D(t.x(), t.y(), th);
+}
+
+std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool align_se2)
 {
 	PathMetrics m;
+	if (align_se2)
+	{
+		std::vector<Eigen::Vector2d> a, b;
+		for (const auto& r : rows)
+			if (r.estimate.initialized && r.truth)
+			{
+				if (a.empty()) m.truth_T_start = *r.truth - r.estimate.mean;
+				a.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
+				b.emplace_back(r.truth->x(), r.truth->y());
+			}
+		if (a.empty()) return std::nullopt;
+		m.aligned = true;
+		m.truth_T_estimate = alignSE2(a, b);
+	}
+	// The error of an estimate in a frame placed by truth_T_frame, and its
+	// covariance rotated into the truth's frame.
+	auto error = [](const PathRow& r, const CPose2D& truth_T_frame, Eigen::Matrix3d* cov)
+	{
+		const CPose2D est = truth_T_frame + r.estimate.mean;
+		if (cov)
+		{
+			Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+			R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(truth_T_frame.phi()).toRotationMatrix();
+			*cov = R * r.estimate.cov * R.transpose();
+		}
+		return Eigen::Vector3d(est.x() - r.truth->x(), est.y() - r.truth->y(),
+			mrpt::math::wrapToPi(est.phi() - r.truth->phi()));
+	};
 	double se = 0, syaw = 0, snees = 0;
 	for (const auto& r : rows)
 	{
 		if (!r.estimate.initialized || !r.truth) continue;
-		const Eigen::Vector3d e(
-			r.estimate.mean.x() - r.truth->x(), r.estimate.mean.y() - r.truth->y(),
-			mrpt::math::wrapToPi(r.estimate.mean.phi() - r.truth->phi()));
+		const Eigen::Vector3d e = error(r, m.truth_T_estimate, nullptr);
 		const double d2 = e[0] * e[0] + e[1] * e[1];
 		se += d2;
 		syaw += e[2] * e[2];
 		m.max_error_m = std::max(m.max_error_m, std::sqrt(d2));
-		snees += e.dot(r.estimate.cov.ldlt().solve(e));
+		Eigen::Matrix3d cov;
+		const Eigen::Vector3d en = error(r, m.aligned ? m.truth_T_start : m.truth_T_estimate, &cov);
+		snees += en.dot(cov.ldlt().solve(en));
 		++m.matched;
 	}
 	if (m.matched == 0) return std::nullopt;
@@ -264,6 +317,7 @@ std::string summaryJson(const LocalizeSummary& s)
 	o << "  \"sightings_used\": " << s.sightings_used << ",\n";
 	o << "  \"sightings_rejected\": " << s.sightings_rejected << ",\n";
 	o << "  \"sightings_unknown_id\": " << s.sightings_unknown_id << ",\n";
+	o << "  \"sightings_too_oblique\": " << s.sightings_too_oblique << ",\n";
 	o << "  \"reinitializations\": " << s.reinitializations << ",\n";
 	o << "  \"first_fix_step\": " << s.first_fix_step << ",\n";
 	o << "  \"first_fix_time_s\": " << num(s.first_fix_time_s, 3) << ",\n";
@@ -277,6 +331,24 @@ std::string summaryJson(const LocalizeSummary& s)
 		o << "  \"yaw_rmse_deg\": " << num(m.yaw_rmse_deg, 4) << ",\n";
 		o << "  \"nees_mean\": " << num(m.nees_mean, 4) << ",\n";
 		o << "  \"nees_band_95\": [" << num(m.nees_band_low, 4) << ", " << num(m.nees_band_high, 4) << "],\n";
+		// SLAM without a prior map: its frame is the robot's start; the
+		// errors above are after an SE(2) least-squares alignment.
+		// ate, max and yaw errors after an SE(2) least-squares alignment,
+		// NEES in the frame anchored at the true first pose (the SLAM
+		// covariance is relative to the start).
+		o << "  \"alignment\": \"" << (m.aligned ? "se2_least_squares" : "none") << "\",\n";
+		if (m.aligned)
+		{
+			o << "  \"alignment_truth_T_estimate\": [" << num(m.truth_T_estimate.x(), 6) << ", "
+			  << num(m.truth_T_estimate.y(), 6) << ", " << num(m.truth_T_estimate.phi(), 6) << "],\n";
+			o << "  \"nees_frame\": \"anchored_at_true_first_pose\",\n";
+		}
+		if (m.landmarks_matched > 0)
+		{
+			o << "  \"landmarks_matched\": " << m.landmarks_matched << ",\n";
+			o << "  \"landmark_rmse_m\": " << num(m.landmark_rmse_m, 6) << ",\n";
+			o << "  \"landmark_yaw_rmse_deg\": " << num(m.landmark_yaw_rmse_deg, 4) << ",\n";
+		}
 	}
 	o << "  \"time_per_step_ms\": " << num(s.time_per_step_ms, 4) << "\n";
 	o << "}\n";
@@ -308,6 +380,9 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 	if (!req.map_file.empty()) map = loadAnyMap(req.map_file);
 	else if (!slam)
 		throw std::invalid_argument("method '" + s.method + "' needs a landmark map (--map)");
+	if (!slam && map.landmarks.empty())
+		throw std::invalid_argument(
+			req.map_file + ": the map has no landmarks (method '" + s.method + "' needs at least one)");
 	std::optional<GroundTruth> gt;
 	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
 
@@ -354,6 +429,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		s.sightings_used += st.used;
 		s.sightings_rejected += st.rejected;
 		s.sightings_unknown_id += st.unknown_id;
+		s.sightings_too_oblique += step.sightings_too_oblique;
 		s.reinitializations += st.reinitialized ? 1 : 0;
 		s.rows.push_back(std::move(row));
 		++s.steps;
@@ -363,7 +439,30 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
 	s.detect_ms_per_image = images ? 1000.0 * detect_s / images : 0.0;
 	s.slam_map = filter->landmarks();
-	s.metrics = computeMetrics(s.rows);
+	// SLAM without a prior map estimates in the frame of the robot's start:
+	// align it to the ground truth's before comparing.
+	s.metrics = computeMetrics(s.rows, slam && map.landmarks.empty());
+	if (s.metrics && slam && !req.gt_map_file.empty())
+	{
+		// Landmark errors against the true map, in the same alignment.
+		const LandmarkMap truth_map = loadAnyMap(req.gt_map_file);
+		double se = 0, syaw = 0;
+		int n = 0;
+		for (const auto& l : s.slam_map)
+			for (const auto& t : truth_map.landmarks)
+				if (t.id == l.landmark.id)
+				{
+					const auto p = s.metrics->truth_T_estimate +
+						mrpt::poses::CPoint2D(l.landmark.x_m, l.landmark.y_m);
+					se += std::pow(p.x() - t.x_m, 2) + std::pow(p.y() - t.y_m, 2);
+					syaw += std::pow(mrpt::math::wrapToPi(
+						l.landmark.yaw_rad + s.metrics->truth_T_estimate.phi() - t.yaw_rad), 2);
+					++n;
+				}
+		s.metrics->landmarks_matched = n;
+		s.metrics->landmark_rmse_m = n ? std::sqrt(se / n) : 0.0;
+		s.metrics->landmark_yaw_rmse_deg = n ? std::sqrt(syaw / n) * 180.0 / M_PI : 0.0;
+	}
 	if (!req.out_dir.empty()) writeOutputs(s, map, req.out_dir);
 	return s;
 }

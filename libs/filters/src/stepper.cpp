@@ -14,6 +14,7 @@
 #include <mrpt/system/datetime.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -52,6 +53,9 @@ void StepperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	motion.thrunModel.additional_std_phi =
 		c.read_float(s, "thrunModel.additional_std_phi", motion.thrunModel.additional_std_phi);
 	MRPT_LOAD_CONFIG_VAR(detect_images, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(max_view_angle_deg, double, c, s);
+	if (!(max_view_angle_deg > 0))
+		throw std::invalid_argument("[" + s + "] max_view_angle_deg must be > 0 [deg]");
 }
 
 void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
@@ -66,6 +70,7 @@ void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "gaussianModel.minStdXY", motion.gaussianModel.minStdXY, -1, -1);
 	c.write(s, "gaussianModel.minStdPHI", motion.gaussianModel.minStdPHI, -1, -1);
 	c.write(s, "detect_images", detect_images, -1, -1);
+	c.write(s, "max_view_angle_deg", max_view_angle_deg, -1, -1);
 }
 
 CPose2D interpolatePose(double t0, const CPose2D& p0, double t1, const CPose2D& p1, double t)
@@ -150,7 +155,7 @@ struct RawlogStepper::Impl
 		else if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj))
 		{
 			actions_observations = true;
-			onActions(*acts);
+			onActions(*acts, entry);
 		}
 		else if (auto o = std::dynamic_pointer_cast<CObservation>(obj))
 			onObservation(o, entry);
@@ -161,7 +166,7 @@ struct RawlogStepper::Impl
 		return nullptr;
 	}
 
-	void onActions(const mrpt::obs::CActionCollection& acts)
+	void onActions(const mrpt::obs::CActionCollection& acts, long entry)
 	{
 		for (const auto& a : acts)
 		{
@@ -169,6 +174,12 @@ struct RawlogStepper::Impl
 			if (!mv || !mv->poseChange) continue;
 			mrpt::poses::CPosePDFGaussian g;
 			g.copyFrom(*mv->poseChange);
+			if (!std::isfinite(g.mean.x()) || !std::isfinite(g.mean.y()) || !std::isfinite(g.mean.phi()))
+				throw std::runtime_error(where(entry) + ": odometry increment (CActionRobotMovement2D) is not finite: " +
+					g.mean.asString());
+			if (!g.cov.asEigen().allFinite())
+				throw std::runtime_error(
+					where(entry) + ": odometry increment (CActionRobotMovement2D) has a non-finite covariance");
 			if (!acc) acc = g;
 			else *acc += g;
 			break;  // one movement per collection
@@ -222,6 +233,10 @@ struct RawlogStepper::Impl
 	{
 		if (auto odo = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(o))
 		{
+			if (!std::isfinite(odo->odometry.x()) || !std::isfinite(odo->odometry.y()) ||
+				!std::isfinite(odo->odometry.phi()))
+				throw std::runtime_error(where(entry) + ": odometry reading (CObservationOdometry '" +
+					odo->sensorLabel + "') is not finite: " + odo->odometry.asString());
 			closeOpen();
 			const double t = mrpt::Clock::toDouble(odo->timestamp);
 			const double interval = last_odo ? t - last_odo->first : 0.0;
@@ -299,6 +314,40 @@ struct RawlogStepper::Impl
 		}
 	}
 
+	// NaN or inf in a measurement the filters fuse: a clear error naming the
+	// entry, never a silently wrong estimate.
+	void checkFinite(const CObservation& o, long entry) const
+	{
+		if (const auto* c = dynamic_cast<const CObservationCodedLandmarks*>(&o))
+		{
+			for (std::size_t i = 0; i < c->sightings.size(); ++i)
+			{
+				const auto& t = c->sightings[i];
+				const char* bad = !t.L.allFinite() ? "L"
+					: !t.C_L.allFinite()           ? "C_L"
+					: !t.pose_in_landmark.allFinite() ? "pose_in_landmark"
+					: !t.C_R.allFinite()           ? "C_R"
+												   : nullptr;
+				if (bad)
+					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): sighting #" +
+						std::to_string(i) + " (ID " + std::to_string(t.id) + ") has a non-finite " + bad);
+			}
+		}
+		else if (const auto* b = dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&o))
+		{
+			for (std::size_t i = 0; i < b->sensedData.size(); ++i)
+			{
+				const auto& m = b->sensedData[i];
+				const bool ok = std::isfinite(m.range) && std::isfinite(m.yaw) && std::isfinite(m.pitch) &&
+					(!b->validCovariances || m.covariance.asEigen().allFinite());
+				if (!ok)
+					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): reading #" +
+						std::to_string(i) + " (landmark ID " + std::to_string(m.landmarkID) +
+						") has a non-finite range, yaw, pitch or covariance");
+			}
+		}
+	}
+
 	void emit(const Frame& f, const mrpt::obs::CActionRobotMovement2D::Ptr& odo)
 	{
 		RawlogStep s;
@@ -313,6 +362,7 @@ struct RawlogStepper::Impl
 			if (dynamic_cast<const CObservationCodedLandmarks*>(o.get())) annotated.push_back(o->sensorLabel);
 		for (const auto& o : f.obs)
 		{
+			checkFinite(*o, f.entry);
 			if (auto img = std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(o))
 			{
 				if (!opt.detect_images) continue;
@@ -332,7 +382,38 @@ struct RawlogStepper::Impl
 			else
 				s.observations.insert(o);
 		}
+		dropOblique(s);
 		ready.push_back(std::move(s));
+	}
+
+	// Replaces coded observations that hold sightings beyond
+	// max_view_angle_deg by copies without them.
+	void dropOblique(RawlogStep& s) const
+	{
+		if (opt.max_view_angle_deg >= 90.0) return;
+		const double max_rad = opt.max_view_angle_deg * M_PI / 180.0;
+		auto oblique = [&](const CObservationCodedLandmarks::TSighting& t)
+		{ return std::abs(mrpt::math::wrapToPi(t.L[1] + t.L[2])) > max_rad; };
+		mrpt::obs::CSensoryFrame out;
+		bool changed = false;
+		for (const auto& o : s.observations)
+		{
+			const auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o);
+			if (!c || std::none_of(c->sightings.begin(), c->sightings.end(), oblique))
+			{
+				out.insert(o);
+				continue;
+			}
+			auto copy = std::make_shared<CObservationCodedLandmarks>(*c);
+			const auto n = copy->sightings.size();
+			copy->sightings.erase(
+				std::remove_if(copy->sightings.begin(), copy->sightings.end(), oblique),
+				copy->sightings.end());
+			s.sightings_too_oblique += static_cast<int>(n - copy->sightings.size());
+			out.insert(copy);
+			changed = true;
+		}
+		if (changed) s.observations = std::move(out);
 	}
 };
 

@@ -50,6 +50,12 @@ struct EkfOptions : public mrpt::config::CLoadableOptions
 	 * [rad^2], for unmodelled odometry errors (e.g. a scale error). */
 	double extra_motion_var_xy_m2 = 1e-6;
 	double extra_motion_var_yaw_rad2 = 1e-6;  //!< see extra_motion_var_xy_m2
+	/** ekf (L measurements): Gauss-Newton iterations of each update (the
+	 * iterated EKF, h re-linearised at the updated estimate); 1 = the plain
+	 * EKF update. Each iteration must lower the MAP cost (prior plus
+	 * measurement terms), else the iterations stop; they also stop once a step
+	 * is below 1e-7 m / 1e-8 rad. */
+	int iterations = 10;
 	/** Relative tolerance of the covariance check: the smallest eigenvalue
 	 * must be >= -tol * max(1, largest); smaller negative ones throw. Tiny
 	 * eigenvalues in between are raised to min_eigenvalue. */

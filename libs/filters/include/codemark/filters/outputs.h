@@ -8,6 +8,8 @@
  */
 #include <codemark/filters/localizer.h>
 
+#include <Eigen/Core>
+
 #include <functional>
 #include <optional>
 #include <string>
@@ -23,6 +25,9 @@ struct LocalizeRequest
 	std::string map_file;  //!< landmark map (spec section 3) or MRPT landmark file; may be empty for SLAM
 	std::string method;  //!< ekf | ekf-pose | ekf-slam | pf; empty: the ini's [localize] method, else ekf
 	std::string gt_file;  //!< ground truth (either form of spec section 6); may be empty
+	/** SLAM: the true landmark map (spec section 3 or MRPT's landmark file)
+	 * for summary.json's landmark_rmse_m; may be empty. */
+	std::string gt_map_file;
 	std::string out_dir;  //!< output folder (created)
 };
 
@@ -47,6 +52,24 @@ struct PathMetrics
 	/** Two-sided 95% band of the mean NEES of a consistent filter:
 	 * chi2inv(0.025 / 0.975, 3 N) / N. */
 	double nees_band_low = 0, nees_band_high = 0;
+	/** True when the estimate was rigidly aligned to the ground truth before
+	 * the errors were taken (SLAM without a prior map: its frame is the
+	 * robot's start, arbitrary with respect to the ground truth's). */
+	bool aligned = false;
+	/** The alignment, truth_T_estimate (x, y [m], yaw [rad]): the SE(2)
+	 * least-squares fit of the estimated positions onto the true ones
+	 * (Horn/Umeyama without scale); identity when not aligned. */
+	mrpt::poses::CPose2D truth_T_estimate;
+	/** When aligned: the NEES is not taken in the least-squares alignment
+	 * (the filter's covariance is relative to its own frame, the robot's
+	 * start, where it is zero) but with the estimate's frame anchored at the
+	 * true first pose: truth_T_start = truth_0 (+) (-estimate_0). */
+	mrpt::poses::CPose2D truth_T_start;
+	/** SLAM with ground truth map: RMS of the landmark position error after
+	 * the same alignment [m], and the number of landmarks compared (0: none). */
+	double landmark_rmse_m = 0;
+	double landmark_yaw_rmse_deg = 0;  //!< as landmark_rmse_m: RMS of the wrapped yaw error [deg]
+	int landmarks_matched = 0;
 };
 
 /** What a run did. */
@@ -55,6 +78,9 @@ struct LocalizeSummary
 	std::string method;
 	long steps = 0;  //!< processed camera frames
 	long sightings_used = 0, sightings_rejected = 0, sightings_unknown_id = 0;
+	/** Coded sightings dropped before the filter as seen beyond
+	 * [stepper] max_view_angle_deg (not in sightings_rejected). */
+	long sightings_too_oblique = 0;
 	long reinitializations = 0;  //!< global initialisation and kidnap recoveries
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
@@ -65,8 +91,17 @@ struct LocalizeSummary
 	std::vector<MappedLandmark> slam_map;  //!< SLAM only
 };
 
-/** Metrics of \a rows (those initialised and with truth); none matched: nullopt. */
-std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows);
+/** Metrics of \a rows (those initialised and with truth); none matched: nullopt.
+ * \a align_se2: first fit truth_T_estimate (rotation and translation, no
+ * scale) minimising the squared position errors, and compare the aligned
+ * estimate (its covariance rotated with it) with the truth. */
+std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool align_se2 = false);
+
+/** The SE(2) least-squares alignment b_T_a of 2D points \a a onto \a b
+ * (pairs, at least one): closed form (Horn 1987 / Umeyama 1991 in the
+ * plane, no scale). */
+mrpt::poses::CPose2D alignSE2(
+	const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b);
 
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
