@@ -52,7 +52,7 @@ DetectionResult detect(
 	cv::Mat labels;
 	const auto candidates =
 		findCandidates(mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
-			&res.counts.components);
+			&res.counts.components, geometry.cell_size_m / geometry.inner_size_m);
 	res.counts.rois = static_cast<int>(candidates.size());
 	tm.components_us = microsSince(t);
 

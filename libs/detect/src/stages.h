@@ -47,10 +47,12 @@ struct Candidate
 /** N4-connected components of \a mask (from segmentColour with grid step
  * \a step), filtered by cardinality and compactness, largest first. The
  * labels image is returned through \a labels and the number of components
- * (before filtering) through \a num_components when given. */
+ * (before filtering) through \a num_components when given. \a centre_cell_rel
+ * is the code cell's size over the reference square's side (the centre
+ * evidence test, ComponentParams::min_centre_cell_px). */
 std::vector<Candidate> findCandidates(
 	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
-	cv::Mat* labels = nullptr, int* num_components = nullptr);
+	cv::Mat* labels = nullptr, int* num_components = nullptr, double centre_cell_rel = 30.0 / 160);
 
 // ------------------------------------------------------------------ stage 4
 /** Polarity of an edgel, named after the inner frame edge that has it: the

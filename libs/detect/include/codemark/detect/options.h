@@ -67,6 +67,16 @@ struct ComponentParams
 	 * under 2 px wide at 5 m and 60 deg does not reach black). 1 disables. */
 	double max_frame_ratio = 0.4;
 	double max_side_frame_ratio = 0.7;
+	/** Centre evidence: the code board's centre cell is always black, so a
+	 * landmark's fill component has a hole at its centre. When the centre
+	 * cell is surely large enough to open that hole in the mask (its
+	 * smallest size estimate, cell / inner side x the box's smaller extent
+	 * / sqrt(2), at least this many pixels: a black cell 8 px wide stays
+	 * below 1% green at its middle under a 1.5 px blur), a component with
+	 * no non-fill cell within half a cell (plus a grid step) of its box's
+	 * centre is rejected before the gradients [px]. Solid green shapes cost
+	 * the edgel stage most; smaller components skip the test. 0 disables. */
+	double min_centre_cell_px = 8;
 	/** At most this many candidates are examined per image (largest first). */
 	int max_candidates = 64;
 };
