@@ -75,6 +75,10 @@ struct EdgelDomain
 	Eigen::Vector2d dir = Eigen::Vector2d::UnitX();  //!< principal direction (unit)
 	double length_px = 0;  //!< extent along dir (max - min projection) [px]
 	double width_px = 0;  //!< sqrt of the smaller eigenvalue (slimness) [px]
+	/** Size of a pixel of the gradient image the domain was found in [px]
+	 * (EdgelMap::scale): a straight edge's edgels there form a staircase
+	 * whose width is a fraction of that pixel. */
+	double pixel_px = 1;
 	Eigen::Vector2d end0 = Eigen::Vector2d::Zero(), end1 = Eigen::Vector2d::Zero();  //!< extreme edgels along dir
 };
 
@@ -105,10 +109,14 @@ using SideSegments = std::array<EdgelDomain, 4>;
 /** Picks, for each side, the domain of that polarity on that side of the
  * fill's centroid, long and slim enough, with the fill colour just inside
  * it in \a mask (grid step \a step; an empty mask skips that test),
- * nearest the fill's bounding box side. */
+ * nearest the fill's bounding box side. With \a bgr given, the fill must
+ * also be seen in the image right inside the domain (G at least half the
+ * fill's, above R and B), 1.5 px plus half a gradient-image pixel inwards:
+ * the grid mask is coarser, and the sheet's edge against a darker wall lies
+ * only a thin frame (1.6-3.2 px at 5 m) outside the inner edge. */
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p);
+	const SegmentParams& p, const cv::Mat* bgr = nullptr);
 
 // ------------------------------------------------------------------ stage 6
 /** Coarse corners TL, TR, BR, BL [raw px]. */

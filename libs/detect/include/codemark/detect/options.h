@@ -110,7 +110,10 @@ struct SegmentParams
 	 * cell edge is at most 3/16 of the side. */
 	double min_rel_length = 0.4;
 	/** Largest width of a domain: sqrt of the smaller eigenvalue of its
-	 * second-order moments (slimness) [px]. */
+	 * second-order moments (slimness), in pixels of the gradient image the
+	 * domain was found in (reduced for ROIs above edgels.max_roi_px: there a
+	 * straight but slanted edge is a staircase a fraction of that pixel
+	 * wide) [px]. */
 	double max_width_px = 1.5;
 };
 
