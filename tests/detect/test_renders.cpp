@@ -147,6 +147,49 @@ TEST(Renders, Combination2mBlur1p5Gain0p3)
 	}
 }
 
+TEST(Renders, DistortedCamera)
+{
+	// A wide-angle lens (barrel distortion, tangential terms): the sides are
+	// curved in the raw image; the detector fits its lines undistorted and
+	// reports raw corners, with P from the undistorted ones. The renderer
+	// supersamples each pixel through the distortion.
+	mrpt::img::TCamera cp = CameraModel().params();
+	cp.distortion = mrpt::img::DistortionModel::plumb_bob;
+	cp.dist.fill(0);
+	cp.dist[0] = -0.28;
+	cp.dist[1] = 0.09;
+	cp.dist[2] = 0.001;
+	cp.dist[3] = -0.0015;
+	const CameraModel cam(cp);
+	ASSERT_TRUE(cam.hasDistortion());
+	auto o = nominalRender();
+	o.supersampling = 4;
+	int n = 0;
+	for (const double d : {0.8, 1.2, 2.0, 3.0})
+		for (const int side : {-1, 1})
+		{
+			// Off-centre (a third of the half field of view and up), where
+			// the distortion bends the edges most.
+			Shot s;
+			MapLandmark lm;
+			lm.id = (n * 71 + 5) % 256;
+			s.scene.camera = cam;
+			s.scene.map.landmarks.push_back(lm);
+			s.scene.world_T_camera =
+				sim::levelCameraLookingAt(lm, d, side * 25 * kDeg, 0.08 * d, side * 0.15);
+			s.render = sim::render(s.scene, o, 1200 + n);
+			const auto& t = s.render.truth[0];
+			const std::string what = label("distorted d", d, n);
+			++n;
+			ASSERT_TRUE(t.fully_visible) << what;
+			const auto r = detect::detect(s.render.image, cam, LandmarkGeometry(), DetectorOptions());
+			ASSERT_EQ(r.landmarks.size(), 1u) << what;
+			EXPECT_EQ(r.landmarks[0].detection.id, lm.id) << what;
+			EXPECT_LT(maxCornerError(r.landmarks[0].detection, t), kCornerTolPx) << what;
+			EXPECT_LT((r.landmarks[0].P - t.P).cwiseAbs().maxCoeff(), kCornerTolPx) << what;
+		}
+}
+
 // ---------------------------------------------------------- scene content
 
 TEST(Renders, SeveralLandmarksAreAllFound)
