@@ -70,6 +70,7 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.reach_px", o.subpixel.reach_px);
 	f("subpixel.saturation_level", o.subpixel.saturation_level);
 	f("subpixel.min_frame_px_centroid", o.subpixel.min_frame_px_centroid);
+	f("subpixel.model_outer_edge", o.subpixel.model_outer_edge);
 	f("subpixel.min_rise_rb", o.subpixel.min_rise_rb);
 	f("subpixel.outlier_sigmas", o.subpixel.outlier_sigmas);
 	f("subpixel.min_outlier_px", o.subpixel.min_outlier_px);

@@ -139,10 +139,12 @@ enum class EdgeMode
 /** Sub-pixel position of a step edge on a 1D profile, from the derivative
  * (values[k+1] - values[k-1]) around its largest value within [lo, hi]
  * (indices), the edge rising in the direction of increasing index. Nullopt
- * when the peak derivative is below \a min_rise (grey levels per px). */
+ * when the peak derivative is below \a min_rise (grey levels per px). In
+ * Peak mode with \a neighbour_px > 0, the lobe of a falling edge that far
+ * before this one (a thin frame's outer edge) is modelled and removed. */
 std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
-	EdgeMode mode = EdgeMode::Centroid);
+	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit

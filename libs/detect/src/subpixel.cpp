@@ -7,8 +7,33 @@
 
 namespace codemark::detect
 {
+namespace
+{
+/** The peak of three samples a, b, c at -1, 0, 1 (b the largest): a
+ * Gaussian through them (log-parabola), or a parabola where the logarithm
+ * is undefined. Returns the offset and, for the Gaussian, its variance
+ * through \a var (0 otherwise). */
+double peakOffset(double a, double b, double c, double& var)
+{
+	var = 0;
+	if (a > 0 && c > 0 && b > 0)
+	{
+		const double la = std::log(a), lb = std::log(b), lc = std::log(c);
+		const double den = la - 2 * lb + lc;
+		if (den < 0)
+		{
+			var = -1 / den;
+			return std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
+		}
+	}
+	const double den = a - 2.0 * b + c;
+	return den < 0 ? std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : 0.0;
+}
+}  // namespace
+
 std::optional<double> locateRisingEdge(
-	const int* v, int n, int lo, int hi, double min_rise, const SubpixelParams& p, EdgeMode mode)
+	const int* v, int n, int lo, int hi, double min_rise, const SubpixelParams& p, EdgeMode mode,
+	double neighbour_px)
 {
 	lo = std::max(lo, 1);
 	hi = std::min(hi, n - 2);
@@ -26,16 +51,40 @@ std::optional<double> locateRisingEdge(
 	{
 		// The derivative's peak: a Gaussian (log-parabola) through the three
 		// samples around it.
-		const double a = d(peak - 1 >= 1 ? peak - 1 : peak), c = d(peak + 1 <= n - 2 ? peak + 1 : peak);
-		if (a > 0 && c > 0)
+		const int km = peak - 1 >= 1 ? peak - 1 : peak, kp = peak + 1 <= n - 2 ? peak + 1 : peak;
+		double var = 0;
+		double e = peak + peakOffset(d(km), dp, d(kp), var);
+		// A falling edge neighbour_px before this one (the frame's outer
+		// edge) adds a negative lobe whose tail tilts the three samples and
+		// pulls the peak away from it, by up to half a pixel when the frame
+		// is 1.6 px wide. Remove a Gaussian model of that lobe (its width
+		// that of the peak, its height from the samples at the neighbour,
+		// less this peak's tail there) and fit again, a few times.
+		const int ko = static_cast<int>(std::lround(e - neighbour_px));
+		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < km)
 		{
-			const double la = std::log(a), lb = std::log(double(dp)), lc = std::log(c);
-			const double den = la - 2 * lb + lc;
-			if (den < 0) return peak + std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
+			int lowest = d(ko);
+			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, km - 1); ++k) lowest = std::min(lowest, d(k));
+			if (lowest < 0)
+			{
+				double amp = dp;
+				for (int it = 0; it < 4 && var > 0; ++it)
+				{
+					const double o = e - neighbour_px;
+					const double g = [&] { return std::exp(-neighbour_px * neighbour_px / (2 * var)); }();
+					const double B = -lowest + amp * g;
+					const auto lobe = [&](int k) { return B * std::exp(-(k - o) * (k - o) / (2 * var)); };
+					const double a = d(km) + lobe(km), b = dp + lobe(peak), c = d(kp) + lobe(kp);
+					double v2 = 0;
+					const double off = peakOffset(a, b, c, v2);
+					if (v2 <= 0) break;
+					e = peak + off;
+					var = v2;
+					amp = b;
+				}
+			}
 		}
-		// A plain parabola where the logarithm is undefined.
-		const double den = a - 2.0 * dp + c;
-		return den < 0 ? peak + std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : double(peak);
+		return e;
 	}
 	// The response of a blurred step: sum the derivative while it stays
 	// positive and above a fraction of the peak; its centroid is the edge
@@ -226,7 +275,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 				return gp[i] > -rbp[i];
 			};
 			const auto locate = [&](int l, int h) -> std::optional<double> {
-				if (!side_saturated) return locateRisingEdge(gp, n, l, h, min_rise, p, mode);
+				if (!side_saturated)
+					return locateRisingEdge(gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.

@@ -156,6 +156,12 @@ struct SubpixelParams
 	 * at the derivative's peak (Gaussian through three samples), which the
 	 * neighbour shifts far less than the centroid. */
 	double min_frame_px_centroid = 6;
+	/** On such thin frames, remove a Gaussian model of the outer edge's
+	 * derivative lobe (a frame width outside, as wide as the inner edge's,
+	 * its height read from the profile) before locating the peak: that
+	 * lobe's tail pulls the peak inwards by 0.2-0.5 px when the frame is
+	 * 1.6-2.3 px wide (5 m at 45-60 deg). */
+	bool model_outer_edge = true;
 	/** Smallest slope of R + B accepted on a saturated profile [grey levels
 	 * per px]. */
 	double min_rise_rb = 4;
