@@ -16,12 +16,11 @@ using namespace codemark::detect::test;
 namespace
 {
 constexpr double kCornerTolPx = 0.3;
-// Known limits (see the report of issue 3): where the green fill saturates
-// the sensor (gain > 1: G clipped at 255 between 1x and ~1.7x its printed
-// level) the edge's bright side is cut and the edges move outwards by up to
-// ~0.4 px; at 5 m and 60 deg the black frame is 1.6 px wide across the
-// vertical sides and its outer edge pulls the inner one.
-constexpr double kSaturatedTolPx = 0.6;
+// Known limit (see the report of issue 3): at 5 m and 60 deg the black
+// frame is 1.6 px wide across the vertical sides; the detector removes a
+// model of its outer edge's pull on the inner one, but single corners still
+// err by up to ~0.45 px there (the mean over the benchmark's 5 m frames is
+// ~0.1 px).
 constexpr double kFarObliqueTolPx = 0.5;
 
 /** Renders one landmark and checks it is found, with its ID and corners. */
@@ -77,7 +76,7 @@ TEST(Renders, ViewAngle0To60Deg)
 TEST(Renders, IlluminationGainWithGradient)
 {
 	int n = 0;
-	for (double gain : {0.3, 0.45, 0.7, 1.0, 1.4, 2.0})
+	for (double gain : {0.3, 0.45, 0.7, 1.0, 1.2, 1.4, 1.7, 2.0})
 		for (double gradient : {0.0, 0.5})
 			for (double angle : {0.0, 40.0})
 			{
@@ -86,10 +85,10 @@ TEST(Renders, IlluminationGainWithGradient)
 				o.gradient = gradient;
 				o.gradient_angle_rad = n * 0.7;
 				expectFound(label("gain", gain, n), (n * 71 + 5) % 256, 2.0, angle * kDeg, o, 200 + n, 0.1, 0,
-					gain > 1 ? kSaturatedTolPx : kCornerTolPx);
+					kCornerTolPx);
 				++n;
 			}
-	EXPECT_EQ(n, 24);
+	EXPECT_EQ(n, 32);
 }
 
 TEST(Renders, NoiseUpTo5)

@@ -217,7 +217,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int n = 2 * half + 1;
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
-		int saturated = 0, heavy = 0;
+		int saturated = 0, clipped = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
 			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
@@ -226,7 +226,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 			const int c_first = c0 - half, c_last = c0 + half;
 			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H)) continue;
 			double fill_sum = 0;
-			const size_t first = g_prof.size();
 			for (int i = 0; i < n; ++i)
 			{
 				const int c = c0 + inward * (i - half);
@@ -238,29 +237,33 @@ std::optional<RefinedQuad> refineQuadrangle(
 			if (fill_sum >= p.saturation_level * (n - hi - 2))
 			{
 				++saturated;
-				// Heavily: the profile clips right after its steepest point.
-				const int* gp = g_prof.data() + first;
+				// Clipped: G reaches the sensor's top within two samples of
+				// its steepest point, where the peak fit reads it.
+				const int* gp = g_prof.data() + (g_prof.size() - n);
 				int k = lo;
 				for (int i = lo + 1; i <= hi; ++i)
 					if (gp[i + 1] - gp[i - 1] > gp[k + 1] - gp[k - 1]) k = i;
-				heavy += gp[k + 1] >= 254;
+				clipped += gp[std::min(n - 1, k + 2)] >= 254;
 			}
 			pos.push_back(s);
 			origin.push_back(c0);
 		}
 		// G saturates on bright fills (the sensor clips at 255), which cuts
 		// the response on the bright side and pulls its centroid towards the
-		// frame. A side is saturated when most of its profiles' fill sides
-		// average above saturation_level (noise around a fill of exactly 255
-		// does not count): its edges are then at the G derivative's peak,
-		// which mild clipping (above the step's middle) leaves in place. When
-		// most profiles clip right after their steepest point, not even the
-		// peak is seen: the edge is found in R + B (dark in the green fill,
-		// unsaturated in the black frame). One estimator per side: mixing
-		// them would split the points into two populations.
+		// frame; even the derivative's peak moves outwards once the clip
+		// comes within a sample of it (0.2-0.4 px at gain 1.2-1.5). A side is
+		// saturated when most of its profiles' fill sides average above
+		// saturation_level (noise around a fill of exactly 255 does not
+		// count): its edges are then at the G derivative's peak, unless most
+		// profiles reach 255 within two samples of it: then in R + B (dark in
+		// the green fill, unsaturated in the black frame), next to the G
+		// peak, except on thin frames where R + B's outer edge is too close.
+		// (R + B alone would suffer from JPEG's chroma subsampling.) One
+		// estimator per side: mixing them would split the points into two
+		// populations.
 		const int half_count = static_cast<int>(pos.size()) / 2;
 		const bool side_saturated = saturated > half_count;
-		const bool side_heavy = heavy > half_count;
+		const bool side_clipped = clipped > half_count;
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)
@@ -284,7 +287,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 				if (!g_peak) return std::nullopt;
 				std::optional<double> r;
 				const int k = static_cast<int>(std::lround(*g_peak));
-				if (side_heavy && mode == EdgeMode::Centroid)
+				if (side_clipped && mode == EdgeMode::Centroid)
 					r = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
 				return r ? r : g_peak;
 			};
