@@ -61,10 +61,10 @@ std::optional<double> locateRisingEdge(
 		// that of the peak, its height from the samples at the neighbour,
 		// less this peak's tail there) and fit again, a few times.
 		const int ko = static_cast<int>(std::lround(e - neighbour_px));
-		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < km)
+		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < peak)
 		{
 			int lowest = d(ko);
-			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, km - 1); ++k) lowest = std::min(lowest, d(k));
+			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, peak - 1); ++k) lowest = std::min(lowest, d(k));
 			if (lowest < 0)
 			{
 				double amp = dp;
@@ -207,8 +207,12 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// inwards, while the peak barely moves.
 		const Eigen::Vector2d prev_side = coarse[side] - coarse[(side + 3) % 4];
 		const Eigen::Vector2d next_side = coarse[(side + 2) % 4] - coarse[(side + 1) % 4];
-		const double frame_px =
-			frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across)));
+		// Perspective: the frame next to this side is wider or narrower than
+		// the average in the ratio of this side's length (its local scale)
+		// to the mean of it and the opposite side's.
+		const double own = ab.norm(), opposite = (coarse[(side + 3) % 4] - coarse[(side + 2) % 4]).norm();
+		const double frame_px = frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across))) *
+			(own + opposite > 0 ? 2 * own / (own + opposite) : 1.0);
 		const EdgeMode mode = frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
 		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
 		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
@@ -283,7 +287,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.
-				const auto g_peak = locateRisingEdge(gp, n, l, h, min_rise, p, EdgeMode::Peak);
+				const auto g_peak = locateRisingEdge(
+					gp, n, l, h, min_rise, p, EdgeMode::Peak, p.model_outer_edge && !side_clipped ? frame_px : 0.0);
 				if (!g_peak) return std::nullopt;
 				std::optional<double> r;
 				const int k = static_cast<int>(std::lround(*g_peak));
