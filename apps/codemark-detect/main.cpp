@@ -102,7 +102,18 @@ struct Runner
 			dbg = (fs::path(debug_dir) / flatName(name)).string();
 			fs::create_directories(dbg);
 		}
-		const auto res = detect::detect(img, camera, geometry, options, dbg);
+		detect::DetectionResult res;
+		try
+		{
+			res = detect::detect(img, camera, geometry, options, dbg);
+		}
+		catch (const std::exception& e)
+		{
+			// One error line for this input (e.g. out of memory on a huge
+			// frame); the run goes on.
+			fail(name, std::string("detection failed: ") + e.what());
+			return;
+		}
 		// L, C_L, pose_in_landmark and C_R of each detection (spec section 5).
 		std::vector<detect::JsonFields> extra;
 		for (const auto& d : res.landmarks)

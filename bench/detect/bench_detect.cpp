@@ -320,8 +320,11 @@ bool allVisible(const Placement& pl, const CameraModel& cam, const CPose3D& worl
 struct StageLog
 {
 	std::vector<double> seg, comp, edg, segm, quad, sub, code, total;
-	void add(const codemark::detect::StageTimings& t)
+	std::vector<int> rois;  // ROIs examined per frame
+	int lastRois() const { return rois.empty() ? 0 : rois.back(); }
+	void add(const codemark::detect::StageTimings& t, int n_rois)
 	{
+		rois.push_back(n_rois);
 		seg.push_back(t.segmentation_us);
 		comp.push_back(t.components_us);
 		edg.push_back(t.edgels_us);
@@ -391,6 +394,7 @@ struct Config
 	std::string out;
 	std::string revision;  // source revision, printed in the report
 	std::string dump_dir;  // where codemark's missed sweep frames go (empty: nowhere)
+	std::string clutter_dir;  // where clutter frames with codemark ROIs go (empty: nowhere)
 };
 
 int runBench(const Config& cfg)
@@ -415,7 +419,7 @@ int runBench(const Config& cfg)
 		{"codemark", cb::PrintKind::Codemark,
 		 [&](const cv::Mat& bgr, const CameraModel& c) {
 			 const auto r = codemark::detect::detect(bgr, c, geometry, dopts);
-			 if (stage_sink) stage_sink->add(r.timings);
+			 if (stage_sink) stage_sink->add(r.timings, r.counts.rois);
 			 std::vector<Det> out;
 			 for (const auto& l : r.landmarks) out.push_back({l.detection.id, l.detection.corners});
 			 return out;
@@ -593,6 +597,10 @@ int runBench(const Config& cfg)
 			stage_sink = k == 0 ? &stages_clutter : nullptr;
 			const auto r = timeRun(k, f.bgr, cam, us, &clutter[k].wall_us);
 			stage_sink = nullptr;
+			if (k == 0 && !cfg.clutter_dir.empty() && stages_clutter.lastRois() > 0)
+				cv::imwrite(cfg.clutter_dir + "/clutter-" + std::to_string(i) + "-rois" +
+						std::to_string(stages_clutter.lastRois()) + ".png",
+					f.bgr);
 			clutter[k].times_us.push_back(us);
 			clutter[k].false_pos += long(r.size());
 			if (!r.empty()) ++clutter_any[k];
@@ -748,6 +756,17 @@ int runBench(const Config& cfg)
 	   << stages_sweep.row("one landmark (sweep)") << stages_clutter.row("background only");
 	for (const auto& g : sizes) md << g.stages.row(g.label + ", one landmark");
 	for (const auto& g : counts) md << g.stages.row("640x480, " + g.label + " landmark(s)");
+	{
+		long with = 0, sum = 0;
+		for (int n : stages_clutter.rois)
+		{
+			with += n > 0;
+			sum += n;
+		}
+		md << "\nBackground-only frames in which codemark examined any ROI (a candidate fill past the component "
+			  "tests, reaching the edgel stage): "
+		   << with << " of " << stages_clutter.rois.size() << ", " << sum << " ROIs in all.\n";
+	}
 	md << "\n";
 
 	md << "## Detection\n\nReference square height in the sweep: " << fmt(min_h, 1) << " to " << fmt(max_h, 1)
@@ -945,6 +964,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> scale("", "scale-frames", "frames per image size / landmark count (default 10, quick 2)", false, 0, "N", cmd);
 		TCLAP::ValueArg<std::string> revision("", "revision", "source revision to print in the report", false, "", "TEXT", cmd);
 		TCLAP::ValueArg<std::string> dump("", "dump-misses", "write codemark's missed sweep frames (PNG + true corners) into this existing directory", false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> dump_clutter("", "dump-clutter", "write the background-only frames in which codemark examines ROIs (PNG) into this existing directory", false, "", "DIR", cmd);
 		cmd.parse(argc, argv);
 		Config cfg;
 		cfg.quick = quick.getValue();
@@ -960,6 +980,7 @@ int main(int argc, char** argv)
 		cfg.out = out.getValue();
 		cfg.revision = revision.getValue();
 		cfg.dump_dir = dump.getValue();
+		cfg.clutter_dir = dump_clutter.getValue();
 		return runBench(cfg);
 	}
 	catch (const TCLAP::ArgException& e)

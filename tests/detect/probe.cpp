@@ -39,6 +39,7 @@ int main(int argc, char** argv)
 	ro.blur_sigma_px = blur;
 	ro.jpeg_quality = jpeg;
 	detect::DetectorOptions opt;
+	if (std::getenv("INI")) opt = detect::DetectorOptions::load(std::getenv("INI"));
 	double err_sum = 0, err_max = 0;
 	int found = 0, n = 0;
 	std::vector<double> times;

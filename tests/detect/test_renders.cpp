@@ -16,13 +16,12 @@ using namespace codemark::detect::test;
 namespace
 {
 constexpr double kCornerTolPx = 0.3;
-// Known limits (see the report of issue 3): where the green fill saturates
-// the sensor (gain > 1: G clipped at 255 between 1x and ~1.7x its printed
-// level) the edge's bright side is cut and the edges move outwards by up to
-// ~0.4 px; at 5 m and 60 deg the black frame is 1.6 px wide across the
-// vertical sides and its outer edge pulls the inner one.
-constexpr double kSaturatedTolPx = 0.6;
-constexpr double kFarObliqueTolPx = 0.5;
+// Known limit (see the report of issue 3): at 5 m and 60 deg the black
+// frame is 1.2-2 px wide across the vertical sides, and the inner edge's
+// slope merges with the outer edge's. The detector removes a model of that
+// pull (the mean over the benchmark's 5 m frames is ~0.09 px), but single
+// corners there still err by up to ~0.5 px.
+constexpr double kFarObliqueTolPx = 0.6;
 
 /** Renders one landmark and checks it is found, with its ID and corners. */
 void expectFound(const std::string& what, int id, double dist, double angle_rad, const sim::RenderOptions& o,
@@ -77,7 +76,7 @@ TEST(Renders, ViewAngle0To60Deg)
 TEST(Renders, IlluminationGainWithGradient)
 {
 	int n = 0;
-	for (double gain : {0.3, 0.45, 0.7, 1.0, 1.4, 2.0})
+	for (double gain : {0.3, 0.45, 0.7, 1.0, 1.2, 1.4, 1.7, 2.0})
 		for (double gradient : {0.0, 0.5})
 			for (double angle : {0.0, 40.0})
 			{
@@ -86,10 +85,10 @@ TEST(Renders, IlluminationGainWithGradient)
 				o.gradient = gradient;
 				o.gradient_angle_rad = n * 0.7;
 				expectFound(label("gain", gain, n), (n * 71 + 5) % 256, 2.0, angle * kDeg, o, 200 + n, 0.1, 0,
-					gain > 1 ? kSaturatedTolPx : kCornerTolPx);
+					kCornerTolPx);
 				++n;
 			}
-	EXPECT_EQ(n, 24);
+	EXPECT_EQ(n, 32);
 }
 
 TEST(Renders, NoiseUpTo5)
@@ -145,6 +144,49 @@ TEST(Renders, Combination2mBlur1p5Gain0p3)
 		o.gradient = 0.3;
 		expectFound(label("2m blur1.5 gain0.3", k, k), (k * 89 + 4) % 256, 2.0, (k * 10) * kDeg, o, 700 + k);
 	}
+}
+
+TEST(Renders, DistortedCamera)
+{
+	// A wide-angle lens (barrel distortion, tangential terms): the sides are
+	// curved in the raw image; the detector fits its lines undistorted and
+	// reports raw corners, with P from the undistorted ones. The renderer
+	// supersamples each pixel through the distortion.
+	mrpt::img::TCamera cp = CameraModel().params();
+	cp.distortion = mrpt::img::DistortionModel::plumb_bob;
+	cp.dist.fill(0);
+	cp.dist[0] = -0.28;
+	cp.dist[1] = 0.09;
+	cp.dist[2] = 0.001;
+	cp.dist[3] = -0.0015;
+	const CameraModel cam(cp);
+	ASSERT_TRUE(cam.hasDistortion());
+	auto o = nominalRender();
+	o.supersampling = 4;
+	int n = 0;
+	for (const double d : {0.8, 1.2, 2.0, 3.0})
+		for (const int side : {-1, 1})
+		{
+			// Off-centre (a third of the half field of view and up), where
+			// the distortion bends the edges most.
+			Shot s;
+			MapLandmark lm;
+			lm.id = (n * 71 + 5) % 256;
+			s.scene.camera = cam;
+			s.scene.map.landmarks.push_back(lm);
+			s.scene.world_T_camera =
+				sim::levelCameraLookingAt(lm, d, side * 25 * kDeg, 0.08 * d, side * 0.15);
+			s.render = sim::render(s.scene, o, 1200 + n);
+			const auto& t = s.render.truth[0];
+			const std::string what = label("distorted d", d, n);
+			++n;
+			ASSERT_TRUE(t.fully_visible) << what;
+			const auto r = detect::detect(s.render.image, cam, LandmarkGeometry(), DetectorOptions());
+			ASSERT_EQ(r.landmarks.size(), 1u) << what;
+			EXPECT_EQ(r.landmarks[0].detection.id, lm.id) << what;
+			EXPECT_LT(maxCornerError(r.landmarks[0].detection, t), kCornerTolPx) << what;
+			EXPECT_LT((r.landmarks[0].P - t.P).cwiseAbs().maxCoeff(), kCornerTolPx) << what;
+		}
 }
 
 // ---------------------------------------------------------- scene content

@@ -52,7 +52,7 @@ DetectionResult detect(
 	cv::Mat labels;
 	const auto candidates =
 		findCandidates(mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
-			&res.counts.components);
+			&res.counts.components, geometry.cell_size_m / geometry.inner_size_m);
 	res.counts.rois = static_cast<int>(candidates.size());
 	tm.components_us = microsSince(t);
 
@@ -64,7 +64,7 @@ DetectionResult detect(
 		tm.edgels_us += microsSince(t);
 
 		// 5. Segment selection: size, polarity, slimness, relative length.
-		const auto sides = selectSegments(edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments);
+		const auto sides = selectSegments(edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr);
 		tm.segments_us += microsSince(t);
 		if (debug) dbg.edgels.push_back(std::move(edgels));
 		if (!sides) continue;

@@ -126,6 +126,7 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 			d.end1 = d.mean + k * tmax * d.dir;
 			d.length_px = k * (tmax - tmin + 1);
 			d.width_px *= k;
+			d.pixel_px = k;
 			m.domains.push_back(d);
 		}
 	}
@@ -134,15 +135,35 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p)
+	const SegmentParams& p, const cv::Mat* bgr)
 {
+	// The fill's colour in the image just inside a domain, at two of three
+	// points along it: 1.5 px inwards, 1 px beyond the edgel's rounding,
+	// keeps a blurred edge (sigma <= 1.5 px) on the fill side and a point
+	// 1.5 px inside the sheet's edge on the frame.
+	const auto fillInImage = [&](const EdgelDomain& d, const Eigen::Vector2d& inward) {
+		if (!bgr) return true;
+		int hits = 0;
+		const double reach = 1.5 + 0.5 * (d.pixel_px - 1);
+		for (const double t : {-0.25, 0.0, 0.25})
+		{
+			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
+			const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+			if (x < 0 || y < 0 || x >= bgr->cols || y >= bgr->rows) continue;
+			const uint8_t* px = bgr->ptr<uint8_t>(y) + 3 * x;
+			if (px[1] >= 0.5 * c.fill_g && px[1] > px[0] && px[1] > px[2]) ++hits;
+		}
+		return hits >= 2;
+	};
 	// Is the fill colour found just inside a domain (towards the fill) at
 	// two of three points along it? Rejects edges outside the frame (the
 	// sheet against the wall), which the fill's bounding box may come near
 	// when the codec smears the green over the thin frame.
 	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward) {
 		int hits = 0;
-		const double reach = std::max(2.0, step + 1.0);
+		// The domain's position is known to half a pixel of its gradient
+		// image.
+		const double reach = std::max(2.0, step + 1.0) + 0.5 * (d.pixel_px - 1);
 		for (const double t : {-0.25, 0.0, 0.25})
 		{
 			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
@@ -173,7 +194,7 @@ std::optional<SideSegments> selectSegments(
 		for (const auto& d : domains)
 		{
 			if (d.polarity != pol) continue;
-			if (d.width_px > p.max_width_px) continue;
+			if (d.width_px > p.max_width_px * d.pixel_px) continue;
 			if (d.length_px < p.min_rel_length * extent) continue;
 			// Along the side: a vertical side's direction is mostly vertical.
 			if (std::abs(d.dir(1 - axis)) < std::abs(d.dir(axis))) continue;
@@ -181,6 +202,7 @@ std::optional<SideSegments> selectSegments(
 			Eigen::Vector2d inward = Eigen::Vector2d::Zero();
 			inward(axis) = low_side ? 1 : -1;
 			if (!mask.empty() && !fillInside(d, inward)) continue;
+			if (!fillInImage(d, inward)) continue;
 			const double dist = std::abs(d.mean(axis) - bbox_side);
 			if (dist < best_dist)
 			{

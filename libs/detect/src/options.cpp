@@ -53,6 +53,7 @@ void forEachField(Options& o, F&& f)
 	f("components.roi_grow_px", o.components.roi_grow_px);
 	f("components.max_frame_ratio", o.components.max_frame_ratio);
 	f("components.max_side_frame_ratio", o.components.max_side_frame_ratio);
+	f("components.min_centre_cell_px", o.components.min_centre_cell_px);
 	f("components.max_candidates", o.components.max_candidates);
 	f("edgels.min_gradient", o.edgels.min_gradient);
 	f("edgels.rel_gradient", o.edgels.rel_gradient);
@@ -69,6 +70,7 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.reach_px", o.subpixel.reach_px);
 	f("subpixel.saturation_level", o.subpixel.saturation_level);
 	f("subpixel.min_frame_px_centroid", o.subpixel.min_frame_px_centroid);
+	f("subpixel.model_outer_edge", o.subpixel.model_outer_edge);
 	f("subpixel.min_rise_rb", o.subpixel.min_rise_rb);
 	f("subpixel.outlier_sigmas", o.subpixel.outlier_sigmas);
 	f("subpixel.min_outlier_px", o.subpixel.min_outlier_px);
@@ -100,6 +102,7 @@ void DetectorOptions::validate() const
 	require(c.max_frame_ratio > 0 && c.max_side_frame_ratio >= c.max_frame_ratio, "components.max_frame_ratio/max_side_frame_ratio",
 		"> 0 and max_side_frame_ratio >= max_frame_ratio");
 	require(c.max_candidates >= 1, "components.max_candidates", ">= 1");
+	require(c.min_centre_cell_px >= 0, "components.min_centre_cell_px", ">= 0");
 	require(edgels.min_gradient > 0 && edgels.rel_gradient >= 0, "edgels.min_gradient/rel_gradient", "> 0 / >= 0");
 	require(edgels.min_edgels >= 2, "edgels.min_edgels", ">= 2");
 	require(edgels.max_roi_px >= 16, "edgels.max_roi_px", ">= 16");

@@ -47,10 +47,12 @@ struct Candidate
 /** N4-connected components of \a mask (from segmentColour with grid step
  * \a step), filtered by cardinality and compactness, largest first. The
  * labels image is returned through \a labels and the number of components
- * (before filtering) through \a num_components when given. */
+ * (before filtering) through \a num_components when given. \a centre_cell_rel
+ * is the code cell's size over the reference square's side (the centre
+ * evidence test, ComponentParams::min_centre_cell_px). */
 std::vector<Candidate> findCandidates(
 	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
-	cv::Mat* labels = nullptr, int* num_components = nullptr);
+	cv::Mat* labels = nullptr, int* num_components = nullptr, double centre_cell_rel = 30.0 / 160);
 
 // ------------------------------------------------------------------ stage 4
 /** Polarity of an edgel, named after the inner frame edge that has it: the
@@ -73,6 +75,10 @@ struct EdgelDomain
 	Eigen::Vector2d dir = Eigen::Vector2d::UnitX();  //!< principal direction (unit)
 	double length_px = 0;  //!< extent along dir (max - min projection) [px]
 	double width_px = 0;  //!< sqrt of the smaller eigenvalue (slimness) [px]
+	/** Size of a pixel of the gradient image the domain was found in [px]
+	 * (EdgelMap::scale): a straight edge's edgels there form a staircase
+	 * whose width is a fraction of that pixel. */
+	double pixel_px = 1;
 	Eigen::Vector2d end0 = Eigen::Vector2d::Zero(), end1 = Eigen::Vector2d::Zero();  //!< extreme edgels along dir
 };
 
@@ -103,10 +109,14 @@ using SideSegments = std::array<EdgelDomain, 4>;
 /** Picks, for each side, the domain of that polarity on that side of the
  * fill's centroid, long and slim enough, with the fill colour just inside
  * it in \a mask (grid step \a step; an empty mask skips that test),
- * nearest the fill's bounding box side. */
+ * nearest the fill's bounding box side. With \a bgr given, the fill must
+ * also be seen in the image right inside the domain (G at least half the
+ * fill's, above R and B), 1.5 px plus half a gradient-image pixel inwards:
+ * the grid mask is coarser, and the sheet's edge against a darker wall lies
+ * only a thin frame (1.6-3.2 px at 5 m) outside the inner edge. */
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p);
+	const SegmentParams& p, const cv::Mat* bgr = nullptr);
 
 // ------------------------------------------------------------------ stage 6
 /** Coarse corners TL, TR, BR, BL [raw px]. */
@@ -129,10 +139,12 @@ enum class EdgeMode
 /** Sub-pixel position of a step edge on a 1D profile, from the derivative
  * (values[k+1] - values[k-1]) around its largest value within [lo, hi]
  * (indices), the edge rising in the direction of increasing index. Nullopt
- * when the peak derivative is below \a min_rise (grey levels per px). */
+ * when the peak derivative is below \a min_rise (grey levels per px). In
+ * Peak mode with \a neighbour_px > 0, the lobe of a falling edge that far
+ * before this one (a thin frame's outer edge) is modelled and removed. */
 std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
-	EdgeMode mode = EdgeMode::Centroid);
+	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit

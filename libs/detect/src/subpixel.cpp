@@ -7,8 +7,33 @@
 
 namespace codemark::detect
 {
+namespace
+{
+/** The peak of three samples a, b, c at -1, 0, 1 (b the largest): a
+ * Gaussian through them (log-parabola), or a parabola where the logarithm
+ * is undefined. Returns the offset and, for the Gaussian, its variance
+ * through \a var (0 otherwise). */
+double peakOffset(double a, double b, double c, double& var)
+{
+	var = 0;
+	if (a > 0 && c > 0 && b > 0)
+	{
+		const double la = std::log(a), lb = std::log(b), lc = std::log(c);
+		const double den = la - 2 * lb + lc;
+		if (den < 0)
+		{
+			var = -1 / den;
+			return std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
+		}
+	}
+	const double den = a - 2.0 * b + c;
+	return den < 0 ? std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : 0.0;
+}
+}  // namespace
+
 std::optional<double> locateRisingEdge(
-	const int* v, int n, int lo, int hi, double min_rise, const SubpixelParams& p, EdgeMode mode)
+	const int* v, int n, int lo, int hi, double min_rise, const SubpixelParams& p, EdgeMode mode,
+	double neighbour_px)
 {
 	lo = std::max(lo, 1);
 	hi = std::min(hi, n - 2);
@@ -26,16 +51,40 @@ std::optional<double> locateRisingEdge(
 	{
 		// The derivative's peak: a Gaussian (log-parabola) through the three
 		// samples around it.
-		const double a = d(peak - 1 >= 1 ? peak - 1 : peak), c = d(peak + 1 <= n - 2 ? peak + 1 : peak);
-		if (a > 0 && c > 0)
+		const int km = peak - 1 >= 1 ? peak - 1 : peak, kp = peak + 1 <= n - 2 ? peak + 1 : peak;
+		double var = 0;
+		double e = peak + peakOffset(d(km), dp, d(kp), var);
+		// A falling edge neighbour_px before this one (the frame's outer
+		// edge) adds a negative lobe whose tail tilts the three samples and
+		// pulls the peak away from it, by up to half a pixel when the frame
+		// is 1.6 px wide. Remove a Gaussian model of that lobe (its width
+		// that of the peak, its height from the samples at the neighbour,
+		// less this peak's tail there) and fit again, a few times.
+		const int ko = static_cast<int>(std::lround(e - neighbour_px));
+		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < peak)
 		{
-			const double la = std::log(a), lb = std::log(double(dp)), lc = std::log(c);
-			const double den = la - 2 * lb + lc;
-			if (den < 0) return peak + std::clamp(0.5 * (la - lc) / den, -0.5, 0.5);
+			int lowest = d(ko);
+			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, peak - 1); ++k) lowest = std::min(lowest, d(k));
+			if (lowest < 0)
+			{
+				double amp = dp;
+				for (int it = 0; it < 4 && var > 0; ++it)
+				{
+					const double o = e - neighbour_px;
+					const double g = [&] { return std::exp(-neighbour_px * neighbour_px / (2 * var)); }();
+					const double B = -lowest + amp * g;
+					const auto lobe = [&](int k) { return B * std::exp(-(k - o) * (k - o) / (2 * var)); };
+					const double a = d(km) + lobe(km), b = dp + lobe(peak), c = d(kp) + lobe(kp);
+					double v2 = 0;
+					const double off = peakOffset(a, b, c, v2);
+					if (v2 <= 0) break;
+					e = peak + off;
+					var = v2;
+					amp = b;
+				}
+			}
 		}
-		// A plain parabola where the logarithm is undefined.
-		const double den = a - 2.0 * dp + c;
-		return den < 0 ? peak + std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : double(peak);
+		return e;
 	}
 	// The response of a blurred step: sum the derivative while it stays
 	// positive and above a fraction of the peak; its centroid is the edge
@@ -158,8 +207,12 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// inwards, while the peak barely moves.
 		const Eigen::Vector2d prev_side = coarse[side] - coarse[(side + 3) % 4];
 		const Eigen::Vector2d next_side = coarse[(side + 2) % 4] - coarse[(side + 1) % 4];
-		const double frame_px =
-			frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across)));
+		// Perspective: the frame next to this side is wider or narrower than
+		// the average in the ratio of this side's length (its local scale)
+		// to the mean of it and the opposite side's.
+		const double own = ab.norm(), opposite = (coarse[(side + 3) % 4] - coarse[(side + 2) % 4]).norm();
+		const double frame_px = frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across))) *
+			(own + opposite > 0 ? 2 * own / (own + opposite) : 1.0);
 		const EdgeMode mode = frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
 		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
 		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
@@ -168,7 +221,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int n = 2 * half + 1;
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
-		int saturated = 0, heavy = 0;
+		int saturated = 0, clipped = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
 			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
@@ -177,7 +230,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 			const int c_first = c0 - half, c_last = c0 + half;
 			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H)) continue;
 			double fill_sum = 0;
-			const size_t first = g_prof.size();
 			for (int i = 0; i < n; ++i)
 			{
 				const int c = c0 + inward * (i - half);
@@ -189,29 +241,33 @@ std::optional<RefinedQuad> refineQuadrangle(
 			if (fill_sum >= p.saturation_level * (n - hi - 2))
 			{
 				++saturated;
-				// Heavily: the profile clips right after its steepest point.
-				const int* gp = g_prof.data() + first;
+				// Clipped: G reaches the sensor's top within two samples of
+				// its steepest point, where the peak fit reads it.
+				const int* gp = g_prof.data() + (g_prof.size() - n);
 				int k = lo;
 				for (int i = lo + 1; i <= hi; ++i)
 					if (gp[i + 1] - gp[i - 1] > gp[k + 1] - gp[k - 1]) k = i;
-				heavy += gp[k + 1] >= 254;
+				clipped += gp[std::min(n - 1, k + 2)] >= 254;
 			}
 			pos.push_back(s);
 			origin.push_back(c0);
 		}
 		// G saturates on bright fills (the sensor clips at 255), which cuts
 		// the response on the bright side and pulls its centroid towards the
-		// frame. A side is saturated when most of its profiles' fill sides
-		// average above saturation_level (noise around a fill of exactly 255
-		// does not count): its edges are then at the G derivative's peak,
-		// which mild clipping (above the step's middle) leaves in place. When
-		// most profiles clip right after their steepest point, not even the
-		// peak is seen: the edge is found in R + B (dark in the green fill,
-		// unsaturated in the black frame). One estimator per side: mixing
-		// them would split the points into two populations.
+		// frame; even the derivative's peak moves outwards once the clip
+		// comes within a sample of it (0.2-0.4 px at gain 1.2-1.5). A side is
+		// saturated when most of its profiles' fill sides average above
+		// saturation_level (noise around a fill of exactly 255 does not
+		// count): its edges are then at the G derivative's peak, unless most
+		// profiles reach 255 within two samples of it: then in R + B (dark in
+		// the green fill, unsaturated in the black frame), next to the G
+		// peak, except on thin frames where R + B's outer edge is too close.
+		// (R + B alone would suffer from JPEG's chroma subsampling.) One
+		// estimator per side: mixing them would split the points into two
+		// populations.
 		const int half_count = static_cast<int>(pos.size()) / 2;
 		const bool side_saturated = saturated > half_count;
-		const bool side_heavy = heavy > half_count;
+		const bool side_clipped = clipped > half_count;
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)
@@ -226,15 +282,17 @@ std::optional<RefinedQuad> refineQuadrangle(
 				return gp[i] > -rbp[i];
 			};
 			const auto locate = [&](int l, int h) -> std::optional<double> {
-				if (!side_saturated) return locateRisingEdge(gp, n, l, h, min_rise, p, mode);
+				if (!side_saturated)
+					return locateRisingEdge(gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.
-				const auto g_peak = locateRisingEdge(gp, n, l, h, min_rise, p, EdgeMode::Peak);
+				const auto g_peak = locateRisingEdge(
+					gp, n, l, h, min_rise, p, EdgeMode::Peak, p.model_outer_edge && !side_clipped ? frame_px : 0.0);
 				if (!g_peak) return std::nullopt;
 				std::optional<double> r;
 				const int k = static_cast<int>(std::lround(*g_peak));
-				if (side_heavy && mode == EdgeMode::Centroid)
+				if (side_clipped && mode == EdgeMode::Centroid)
 					r = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
 				return r ? r : g_peak;
 			};

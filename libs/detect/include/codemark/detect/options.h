@@ -67,6 +67,16 @@ struct ComponentParams
 	 * under 2 px wide at 5 m and 60 deg does not reach black). 1 disables. */
 	double max_frame_ratio = 0.4;
 	double max_side_frame_ratio = 0.7;
+	/** Centre evidence: the code board's centre cell is always black, so a
+	 * landmark's fill component has a hole at its centre. When the centre
+	 * cell is surely large enough to open that hole in the mask (its
+	 * smallest size estimate, cell / inner side x the box's smaller extent
+	 * / sqrt(2), at least this many pixels: a black cell 8 px wide stays
+	 * below 1% green at its middle under a 1.5 px blur), a component with
+	 * no non-fill cell within half a cell (plus a grid step) of its box's
+	 * centre is rejected before the gradients [px]. Solid green shapes cost
+	 * the edgel stage most; smaller components skip the test. 0 disables. */
+	double min_centre_cell_px = 8;
 	/** At most this many candidates are examined per image (largest first). */
 	int max_candidates = 64;
 };
@@ -100,7 +110,10 @@ struct SegmentParams
 	 * cell edge is at most 3/16 of the side. */
 	double min_rel_length = 0.4;
 	/** Largest width of a domain: sqrt of the smaller eigenvalue of its
-	 * second-order moments (slimness) [px]. */
+	 * second-order moments (slimness), in pixels of the gradient image the
+	 * domain was found in (reduced for ROIs above edgels.max_roi_px: there a
+	 * straight but slanted edge is a staircase a fraction of that pixel
+	 * wide) [px]. */
 	double max_width_px = 1.5;
 };
 
@@ -143,6 +156,12 @@ struct SubpixelParams
 	 * at the derivative's peak (Gaussian through three samples), which the
 	 * neighbour shifts far less than the centroid. */
 	double min_frame_px_centroid = 6;
+	/** On such thin frames, remove a Gaussian model of the outer edge's
+	 * derivative lobe (a frame width outside, as wide as the inner edge's,
+	 * its height read from the profile) before locating the peak: that
+	 * lobe's tail pulls the peak inwards by 0.2-0.5 px when the frame is
+	 * 1.6-2.3 px wide (5 m at 45-60 deg). */
+	bool model_outer_edge = true;
 	/** Smallest slope of R + B accepted on a saturated profile [grey levels
 	 * per px]. */
 	double min_rise_rb = 4;
