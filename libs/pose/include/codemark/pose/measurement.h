@@ -53,11 +53,13 @@ std::string toString(PoseMethod m);
 /** Throws std::invalid_argument naming the accepted values. */
 PoseMethod poseMethodFromString(const std::string& name);
 
-/** Default standard deviation of each component of P [px]. The spec's
- * shipped default is to be calibrated from the detector's measured corner
- * error (landmark-spec.md section 4); until that calibration exists this is
- * the value the issue asks for (corners good to about 0.05 px, the accuracy
- * targets of issue 4). The paper used 1 px. */
+/** Default standard deviation of each component of P [px] of the pose
+ * library alone (the spec's constant diagonal C_P; the paper used 1 px): the
+ * corner accuracy issue 4's targets assume. codemark's own detector comes
+ * with a calibrated, size-dependent C_P instead
+ * (codemark::pipeline::detectorCalibratedPoseOptions(), measured by
+ * codemark-bench-pose-calib; docs/benchmarks/pose.md), which every tool that
+ * runs the detector uses. */
 constexpr double kDefaultSigmaPx = 0.05;
 
 /** Options of measure(). Loadable from an ini section. */
