@@ -1,13 +1,14 @@
 /** \file pose_calib.cpp
- * codemark-bench-pose-calib: the data behind the pose library's calibrated
- * corner noise (codemark::pipeline::detectorCornerNoise()). Renders a level
- * camera at random poses in front of one landmark (the accuracy map's
- * conditions: flat background, pixel noise 2, blur 0.8 px, the paper's
- * camera), runs codemark's detector, and writes one CSV row per detection
- * with the pose, the apparent size and the errors of the four corners and of
- * P against the renderer's exact truth. Then prints, per distance band, the
- * RMS corner error per coordinate and the correlations that the corner
- * noise model of libs/pose (corner_noise.h) assumes.
+ * codemark-bench-pose-calib: the data behind the detector's calibrated C_P
+ * (codemark::pipeline::detectorCalibratedPoseOptions()). Renders a level
+ * camera at random poses in front of one landmark (the accuracy map's flat
+ * background by default, --realistic for the simulated datasets' scene;
+ * pixel noise 2, blur 0.8 px, the paper's camera), runs codemark's
+ * detector, optionally writes one CSV row per detection (pose, apparent
+ * size, errors of the four corners and of P against the renderer's exact
+ * truth), fits the noise model of pose::PoseOptions::primaryCovariance() by
+ * maximum likelihood and prints it with a per-distance table
+ * (docs/benchmarks/pose.md).
  */
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/primary.h>
