@@ -124,13 +124,13 @@ void checkNees(int k)
 TEST(PoseNees, GeneralPathIsConsistentOnRenders) { checkNees(1); }
 
 // Known gap (issue 4): the closed form's C_R is not consistent on these
-// renders: its mean NEES is 1.8 over 145 sightings (band about [2.6, 3.4]),
-// too conservative, because the calibrated model is one set of constants for
-// all sizes while the detector's y1, y2 errors change their correlation with
-// the landmark's size (+0.9 within 3 m, +0.3 at 5 m; on a flat background
-// -0.45 at 40-50 px, with heavy tails), and the closed form's thin C_R (phi1
-// far better known than phi2) magnifies any misfit. Enable when the model or
-// the detector covers it.
+// renders: its mean NEES is 2.52 over 170 sightings (band [2.64, 3.38]),
+// slightly conservative, because the calibrated model is one set of
+// constants for all sizes while the detector's y1, y2 error correlation
+// changes with the landmark's size and the scene (on a flat background -0.45
+// and heavy-tailed at 40-50 px), and the closed form's thin C_R (phi1 far
+// better known than phi2) magnifies any misfit. Enable when the model or the
+// detector covers it.
 TEST(PoseNees, DISABLED_ClosedFormIsConsistentOnRenders) { checkNees(0); }
 
 // Noise-free renders (no noise, no blur), codemark's detector, both paths,
