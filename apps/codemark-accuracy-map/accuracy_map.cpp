@@ -51,14 +51,21 @@ void accumulate(MethodErrors& e, const pose::Measurement& m, const SightingTruth
 	e.y_m += std::abs(dR[1]);
 	e.theta_rad += std::abs(dR[2]);
 	e.position_m += dR.head<2>().norm();
-	e.nees += dR.dot(m.C_R.ldlt().solve(dR));
+	const double nees = dR.dot(m.C_R.ldlt().solve(dR));
+	e.nees += nees;
+	e.nees_L += dL.dot(m.C_L.ldlt().solve(dL));
+	if (std::sqrt(m.C_L(2, 2)) <= 2 * M_PI / 180)
+	{
+		e.nees_small_phi2_sum += nees;
+		++e.nees_small_phi2_n;
+	}
 }
 
 void finish(MethodErrors& e)
 {
 	if (e.detected == 0) return;
 	const double n = e.detected;
-	for (double* v : {&e.l2_m, &e.phi1_rad, &e.phi2_rad, &e.x_m, &e.y_m, &e.theta_rad, &e.position_m, &e.nees})
+	for (double* v : {&e.l2_m, &e.phi1_rad, &e.phi2_rad, &e.x_m, &e.y_m, &e.theta_rad, &e.position_m, &e.nees, &e.nees_L})
 		*v /= n;
 }
 
@@ -230,9 +237,8 @@ std::vector<CellResult> runSurvey(
 	ro.blur_sigma_px = o.blur_sigma_px;
 	const LandmarkGeometry g = lm.geometry();
 	const detect::DetectorOptions dopt;
-	pose::PoseOptions cf, gen;
-	cf.sigma_px = gen.sigma_px = o.sigma_px;
-	cf.sigma_source = gen.sigma_source = o.sigma_source;
+	pose::PoseOptions cf = o.pose, gen = o.pose;
+	cf.method = pose::PoseMethod::ClosedForm;
 	gen.method = pose::PoseMethod::General6Dof;
 	const TagRenderer tag(g.inner_size_m);
 	const TagDetector tagdet;
@@ -461,8 +467,7 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
 	  << o.renders_per_cell << " renders each, noise " << fmt(o.noise_sigma, 1) << ", blur "
-	  << fmt(o.blur_sigma_px, 2) << " px, sigma_px " << fmt(o.sigma_px, 3) << ", sigma source "
-	  << pose::toString(o.sigma_source) << "\n";
+	  << fmt(o.blur_sigma_px, 2) << " px, C_P " << o.noise_label << "\n";
 	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general 6-DoF,"
 		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's sigma)\n";
 	for (const Region& r : regions)
@@ -521,7 +526,33 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 		row("heading [deg]", [](const MethodErrors& e, const CellResult&) { return e.theta_rad; }, {}, 180 / M_PI, 3);
 		const auto [nc, nr, d0, d1, d2] = row("mean NEES (3 dof)",
 			[](const MethodErrors& e, const CellResult&) { return e.nees; }, {}, 1, 2);
-		if (o.sigma_source == pose::SigmaSource::Fixed)
+		row("mean NEES of L", [](const MethodErrors& e, const CellResult&) { return e.nees_L; }, {}, 1, 2);
+		{
+			// Pose NEES pooled over the sightings whose reported phi2 sigma
+			// is at most 2 deg, with its own 95% band.
+			s << "pose NEES where sigma(phi2) <= 2 deg:";
+			for (int k = 0; k < 2; ++k)
+			{
+				double sum = 0;
+				int n = 0;
+				for (const auto& c : cells)
+				{
+					if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+					const MethodErrors& e = k ? c.general : c.closed_form;
+					sum += e.nees_small_phi2_sum;
+					n += e.nees_small_phi2_n;
+				}
+				s << (k ? "; gen " : " cf ");
+				if (n)
+					s << fmt(sum / n, 2) << " over " << n << " [" << fmt(chi2Quantile(0.025, 3.0 * n) / n, 2) << ", "
+					  << fmt(chi2Quantile(0.975, 3.0 * n) / n, 2) << "]";
+				else
+					s << "-";
+			}
+			s << "\n";
+		}
+		if (o.pose.growth_x_px == 0 && o.pose.growth_y_px == 0 && o.pose.sigma_y_px == 0 &&
+			o.pose.sigma_source == pose::SigmaSource::Fixed)
 		{
 			// NEES scales as 1 / sigma^2: the sigma_px that would make the
 			// region's mean NEES 3 (for calibrating the default).
@@ -540,7 +571,7 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			}
 			s << "sigma_px for mean NEES 3:";
 			for (int k = 0; k < 2; ++k)
-				s << (k ? ", gen " : " cf ") << (n[k] ? fmt(o.sigma_px * std::sqrt(sum[k] / n[k] / 3), 4) : std::string("-"));
+				s << (k ? ", gen " : " cf ") << (n[k] ? fmt(o.pose.sigma_px * std::sqrt(sum[k] / n[k] / 3), 4) : std::string("-"));
 			s << "\n";
 		}
 		{

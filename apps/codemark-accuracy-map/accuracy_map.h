@@ -29,9 +29,12 @@ struct SurveyOptions
 	int renders_per_cell = 5;  //!< noisy renders per cell (different seeds)
 	double noise_sigma = 2.0;  //!< renderer pixel noise [grey levels]
 	double blur_sigma_px = 0.8;  //!< renderer blur [px]
-	double sigma_px = pose::kDefaultSigmaPx;  //!< sigma of each component of P for C_L, C_R [px]
-	/** Fixed: sigma_px; Detector: the detector's per-detection corner sigma. */
-	pose::SigmaSource sigma_source = pose::SigmaSource::Fixed;
+	/** Noise model of P for C_L, C_R (the method field is ignored: both paths
+	 * run). Default: codemark::pipeline::detectorCalibratedPoseOptions(),
+	 * the detector's calibrated, size-dependent C_P. */
+	pose::PoseOptions pose;
+	/** A one-line description of \a pose's noise model for the summary. */
+	std::string noise_label = "calibrated (pipeline::detectorCalibratedPoseOptions)";
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path
 	uint64_t seed = 1;  //!< first render seed
 };
@@ -44,6 +47,11 @@ struct MethodErrors
 	double x_m = 0, y_m = 0, theta_rad = 0;  //!< mean |error| of the pose in L
 	double position_m = 0;  //!< mean Euclidean position error in L
 	double nees = 0;  //!< mean NEES of the pose with the reported C_R (3 dof)
+	double nees_L = 0;  //!< mean NEES of L with the reported C_L (3 dof)
+	/** Sum and count of the pose NEES over the sightings whose reported phi2
+	 * sigma is at most 2 deg (where a Gaussian C_R can hold). */
+	double nees_small_phi2_sum = 0;
+	int nees_small_phi2_n = 0;
 };
 
 /** One grid cell. */
@@ -52,7 +60,7 @@ struct CellResult
 	double X_m = 0, Y_m = 0;  //!< camera position in frame L [m]
 	double distance_m = 0, angle_deg = 0;
 	int renders = 0;
-	/** Predicted 1-sigma (closed form at the exact corners, sigma_px). */
+	/** Predicted 1-sigma (closed form at the exact corners, SurveyOptions::pose). */
 	double sigma_l2_m = 0, sigma_phi1_rad = 0, sigma_phi2_rad = 0, sigma_x_m = 0, sigma_y_m = 0;
 	MethodErrors closed_form, general, apriltag;
 	/** Mean (detected - true) AprilTag corner position over the cell's

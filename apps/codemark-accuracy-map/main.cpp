@@ -7,6 +7,8 @@
 #include <exception>
 #include <iostream>
 
+#include <codemark/pipeline/pipeline.h>
+
 #include "../common/progress.h"
 #include "accuracy_map.h"
 
@@ -35,9 +37,10 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<double> noise_arg("", "noise", "Render noise sigma [grey levels]. Default 2.", false, 2.0, "S", cmd);
 		TCLAP::ValueArg<double> blur_arg("", "blur", "Render blur sigma [px]. Default 0.8.", false, 0.8, "PX", cmd);
 		TCLAP::ValueArg<double> sigma_arg("", "sigma-px",
-			"Sigma of each component of P for the predicted covariances [px]. Default: the pose "
-			"library's default.",
-			false, codemark::pose::kDefaultSigmaPx, "PX", cmd);
+			"A constant sigma of each component of P for the predicted covariances [px] (the "
+			"spec's diagonal C_P). Default: the detector's calibrated, size-dependent C_P "
+			"(codemark::pipeline::detectorCalibratedPoseOptions).",
+			false, 0, "PX", cmd);
 		TCLAP::ValueArg<std::string> sigma_source_arg("", "sigma-source",
 			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default Fixed.",
 			false, "Fixed", "NAME", cmd);
@@ -52,11 +55,19 @@ int main(int argc, char** argv)
 		o.max_distance_m = maxd_arg.getValue();
 		o.noise_sigma = noise_arg.getValue();
 		o.blur_sigma_px = blur_arg.getValue();
-		o.sigma_px = sigma_arg.getValue();
+		o.pose = codemark::pipeline::detectorCalibratedPoseOptions();
+		if (sigma_arg.isSet())
+		{
+			o.pose = codemark::pose::PoseOptions();
+			o.pose.sigma_px = sigma_arg.getValue();
+			o.noise_label = "constant sigma_px " + std::to_string(sigma_arg.getValue());
+		}
 		o.apriltag = !no_tag_arg.getValue();
-		o.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
+		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
+		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
+			o.noise_label = "the detector's per-detection corner sigma";
 		o.seed = seed_arg.getValue();
-		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) || !(o.sigma_px > 0) ||
+		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) || !(o.pose.sigma_px > 0) ||
 			o.noise_sigma < 0 || o.blur_sigma_px < 0)
 			throw std::invalid_argument("--renders >= 1, --cell, --max-distance, --sigma-px > 0, --noise, --blur >= 0");
 		const codemark::CameraModel camera = camera_arg.getValue().empty()

@@ -284,3 +284,78 @@ TEST(Options, SigmaFromTheDetector)
 	d.quality.corner_sigma_px = 0;
 	EXPECT_NEAR(measure(d, cam, g, o).C_P(1, 1), 0.05 * 0.05, 1e-18);
 }
+
+// The size-dependent, correlated C_P of PoseOptions::primaryCovariance().
+TEST(PrimaryCovariance, SizeDependentModel)
+{
+	PoseOptions o;
+	o.sigma_px = 0.03;
+	o.sigma_y_px = 0.05;
+	const Eigen::Vector4d P(-30, 20, 30, 21);  // width 60 px, height 41 px
+	// No growth, no correlation: the spec's diagonal.
+	EXPECT_LT((o.primaryCovariance(P) - primaryCovariance(0.03, 0.05)).norm(), 1e-15);
+	o.growth_x_px = 0.1;
+	o.growth_y_px = 0.2;
+	o.size_exponent_x = 2;
+	o.size_exponent_y = 1;
+	o.size_reference_px = 60;
+	o.corr_x12 = -0.5;
+	o.corr_growth_x12 = -0.9;
+	o.corr_y12 = 0.6;
+	o.corr_growth_y12 = 0.1;
+	const Eigen::Matrix4d C = o.primaryCovariance(P);
+	// At the reference width the growth term is growth_x_px.
+	EXPECT_NEAR(C(0, 0), 0.03 * 0.03 + 0.1 * 0.1, 1e-15);
+	EXPECT_NEAR(C(2, 2), C(0, 0), 1e-15);
+	EXPECT_NEAR(C(0, 2), -0.5 * 0.03 * 0.03 - 0.9 * 0.1 * 0.1, 1e-15);
+	const double gy = 0.2 * 60.0 / 41.0;
+	EXPECT_NEAR(C(1, 1), 0.05 * 0.05 + gy * gy, 1e-15);
+	EXPECT_NEAR(C(1, 3), 0.6 * 0.05 * 0.05 + 0.1 * gy * gy, 1e-15);
+	EXPECT_EQ(C(0, 1), 0);
+	EXPECT_LT((C - C.transpose()).norm(), 1e-18);
+	EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(C).eigenvalues().minCoeff(), 0);
+	// Smaller landmarks are noisier.
+	EXPECT_GT(o.primaryCovariance(P / 2)(0, 0), C(0, 0));
+	o.corr_y12 = 1.0;
+	EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
+// The second-order C_R against the sample covariance of the exact pose of
+// Gaussian L samples, where phi2 is uncertain enough for first order to miss.
+TEST(PoseCovariance, SecondOrderMatchesSamples)
+{
+	const Eigen::Vector3d L(3.5, 0.05, 0.3);
+	Eigen::Matrix3d C_L;
+	C_L << 4e-6, 0, 1e-5,  //
+		0, 1e-8, -2e-6,  //
+		1e-5, -2e-6, 9e-4;  // sigma(phi2) = 1.7 deg, phi1 far better known
+	const Eigen::LLT<Eigen::Matrix3d> llt(C_L);
+	std::mt19937 rng(3);
+	std::normal_distribution<double> n01;
+	const int N = 200000;
+	std::vector<Eigen::Vector3d> poses(N);
+	Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+	const Eigen::Vector3d p0 = poseFromLandmark(L);
+	for (int i = 0; i < N; ++i)
+	{
+		const Eigen::Vector3d l = L + llt.matrixL() * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+		poses[i] = poseFromLandmark(l);
+		poses[i][2] = p0[2] + wrapToPi(poses[i][2] - p0[2]);
+		mean += poses[i] / N;
+	}
+	Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+	for (const auto& p : poses) S += (p - mean) * (p - mean).transpose() / (N - 1);
+	Eigen::Matrix3d J_L;
+	poseFromLandmark(L, &J_L);
+	const Eigen::Matrix3d first = J_L * C_L * J_L.transpose();
+	const Eigen::Matrix3d second = poseCovarianceSecondOrder(L, C_L);
+	// Compare in the metric of the sample covariance (whitened), where the
+	// near-singular direction counts as much as the others.
+	const Eigen::Matrix3d W = S.llt().matrixL().solve(Eigen::Matrix3d::Identity());
+	const double err2 = (W * second * W.transpose() - Eigen::Matrix3d::Identity()).norm();
+	const double err1 = (W * first * W.transpose() - Eigen::Matrix3d::Identity()).norm();
+	// Third and higher orders of cos and sin remain; the second-order term
+	// must take at least half of the first order's misfit away.
+	EXPECT_LT(err2, 0.3) << "first order: " << err1;
+	EXPECT_GT(err1, 2 * err2);
+}

@@ -63,6 +63,27 @@ Eigen::Vector3d poseFromLandmark(const Eigen::Vector3d& L, Eigen::Matrix3d* J_L)
 	return {l2 * c, l2 * sn, wrapToPi(M_PI + L[2])};
 }
 
+Eigen::Matrix3d poseCovarianceSecondOrder(const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L)
+{
+	Eigen::Matrix3d J_L;
+	poseFromLandmark(L, &J_L);
+	const double l2 = L[0], a = L[1] + L[2];
+	const double c = std::cos(a), sn = std::sin(a);
+	// Hessians of x = l2 cos(a) and y = l2 sin(a), a = phi1 + phi2, w.r.t.
+	// (l2, phi1, phi2); theta = pi + phi2 is linear.
+	Eigen::Matrix3d H[2];
+	H[0] << 0, -sn, -sn,  //
+		-sn, -l2 * c, -l2 * c,  //
+		-sn, -l2 * c, -l2 * c;
+	H[1] << 0, c, c,  //
+		c, -l2 * sn, -l2 * sn,  //
+		c, -l2 * sn, -l2 * sn;
+	Eigen::Matrix3d C = J_L * C_L * J_L.transpose();
+	for (int i = 0; i < 2; ++i)
+		for (int j = 0; j < 2; ++j) C(i, j) += 0.5 * (H[i] * C_L * H[j] * C_L).trace();
+	return C;
+}
+
 Eigen::Matrix4d primaryCovariance(double sx, double sy)
 {
 	return Eigen::Vector4d(sx * sx, sy * sy, sx * sx, sy * sy).asDiagonal();

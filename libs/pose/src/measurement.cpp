@@ -58,6 +58,14 @@ void PoseOptions::validate() const
 		throw std::invalid_argument("pose options: sigma_y_px must be finite and >= 0 (0: sigma_px)");
 	if (!(min_sigma_px > 0) || !std::isfinite(min_sigma_px))
 		throw std::invalid_argument("pose options: min_sigma_px must be finite and > 0");
+	if (!(growth_x_px >= 0) || !(growth_y_px >= 0) || !std::isfinite(growth_x_px) || !std::isfinite(growth_y_px))
+		throw std::invalid_argument("pose options: growth_x_px, growth_y_px must be finite and >= 0");
+	if (!(size_reference_px > 0) || !std::isfinite(size_reference_px) || !std::isfinite(size_exponent_x) ||
+		!std::isfinite(size_exponent_y))
+		throw std::invalid_argument("pose options: size_reference_px must be > 0 and the exponents finite");
+	for (const double r : {corr_x12, corr_y12, corr_growth_x12, corr_growth_y12})
+		if (!(std::abs(r) < 1))
+			throw std::invalid_argument("pose options: the correlations corr_* must lie in (-1, 1)");
 	if (lm_max_iterations < 1)
 		throw std::invalid_argument("pose options: lm_max_iterations must be >= 1");
 }
@@ -68,6 +76,16 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(sigma_y_px, double, c, s);
 	sigma_source = sigmaSourceFromString(c.read_string(s, "sigma_source", toString(sigma_source)));
+	MRPT_LOAD_CONFIG_VAR(growth_x_px, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(growth_y_px, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(size_exponent_x, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(size_exponent_y, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(size_reference_px, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(corr_x12, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(corr_y12, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(corr_growth_x12, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(corr_growth_y12, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(second_order_pose_covariance, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lm_max_iterations, int, c, s);
 	validate();
@@ -79,8 +97,33 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(s, "sigma_px", sigma_px, -1, -1, "std. dev. of x1, x2 (and y1, y2 unless sigma_y_px) [px]");
 	c.write(s, "sigma_y_px", sigma_y_px, -1, -1, "std. dev. of y1, y2 [px]; 0: sigma_px");
 	c.write(s, "sigma_source", toString(sigma_source), -1, -1, "Fixed (sigma_px) | Detector (its corner_sigma_px)");
+	c.write(s, "growth_x_px", growth_x_px, -1, -1, "growth of sigma(x1, x2) for small landmarks [px]; 0: constant");
+	c.write(s, "growth_y_px", growth_y_px, -1, -1, "growth of sigma(y1, y2) for small landmarks [px]; 0: constant");
+	c.write(s, "size_exponent_x", size_exponent_x, -1, -1, "sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
+	c.write(s, "size_exponent_y", size_exponent_y, -1, -1, "sigma_y = sqrt(sigma_y_px^2 + (growth_y_px (ref / (y1 + y2))^exp)^2)");
+	c.write(s, "size_reference_px", size_reference_px, -1, -1, "ref of the growth terms [px]");
+	c.write(s, "corr_x12", corr_x12, -1, -1, "correlation of the errors of x1 and x2, constant part");
+	c.write(s, "corr_growth_x12", corr_growth_x12, -1, -1, "the same, size-dependent part");
+	c.write(s, "corr_y12", corr_y12, -1, -1, "correlation of the errors of y1 and y2, constant part");
+	c.write(s, "corr_growth_y12", corr_growth_y12, -1, -1, "the same, size-dependent part");
+	c.write(s, "second_order_pose_covariance", second_order_pose_covariance, -1, -1, "ClosedForm: C_R to second order in C_L");
 	c.write(s, "min_sigma_px", min_sigma_px, -1, -1, "Detector: floor of the sigma of a component of P [px]");
 	c.write(s, "lm_max_iterations", lm_max_iterations, -1, -1, "General6Dof: LM iterations per refinement");
+}
+
+Eigen::Matrix4d PoseOptions::primaryCovariance(const Eigen::Vector4d& P) const
+{
+	// Apparent sizes, floored at 1 px so that a degenerate P gives a large
+	// but finite covariance.
+	const double w = std::max(1.0, std::abs(P[2] - P[0])), h = std::max(1.0, P[1] + P[3]);
+	const double gx = growth_x_px * std::pow(size_reference_px / w, size_exponent_x);
+	const double gy = growth_y_px * std::pow(size_reference_px / h, size_exponent_y);
+	const double fx2 = sigma_px * sigma_px, fy2 = sigmaY() * sigmaY();
+	const double vx = fx2 + gx * gx, vy = fy2 + gy * gy;
+	Eigen::Matrix4d C = Eigen::Vector4d(vx, vy, vx, vy).asDiagonal();
+	C(0, 2) = C(2, 0) = corr_x12 * fx2 + corr_growth_x12 * gx * gx;
+	C(1, 3) = C(3, 1) = corr_y12 * fy2 + corr_growth_y12 * gy * gy;
+	return C;
 }
 
 Measurement measure(
@@ -92,7 +135,7 @@ Measurement measure(
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	m.C_P = primaryCovariance(options.sigma_px, options.sigmaY());
+	m.C_P = options.primaryCovariance(m.P);
 	if (options.method == PoseMethod::ClosedForm)
 	{
 		Eigen::Matrix<double, 3, 4> J_P;
@@ -100,13 +143,14 @@ Measurement measure(
 		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), &J_P);
 		m.C_L = J_P * m.C_P * J_P.transpose();
 		m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
-		m.C_R = J_L * m.C_L * J_L.transpose();
+		m.C_R = options.second_order_pose_covariance ? poseCovarianceSecondOrder(m.L, m.C_L)
+													: Eigen::Matrix3d(J_L * m.C_L * J_L.transpose());
 		return m;
 	}
 	// Each corner coordinate carries sqrt(2) sigma when each component of P
 	// (a mean or half-difference of two corners) carries sigma; the general
 	// path takes one isotropic corner sigma: the RMS of the two.
-	const double sigma_corner = std::sqrt(options.sigma_px * options.sigma_px + options.sigmaY() * options.sigmaY());
+	const double sigma_corner = std::sqrt(m.C_P(0, 0) + m.C_P(1, 1));
 	const GeneralPose g = solveGeneralPose(
 		corners, camera, geometry, sigma_corner, options.lm_max_iterations);
 	m.L = g.L;
@@ -128,6 +172,8 @@ Measurement measure(
 	{
 		o.sigma_px = std::max(o.min_sigma_px, detection.quality.corner_sigma_px / std::sqrt(2.0));
 		o.sigma_y_px = 0;
+		o.growth_x_px = o.growth_y_px = 0;
+		o.corr_x12 = o.corr_y12 = 0;
 	}
 	return measure(detection.corners, camera, geometry, o);
 }

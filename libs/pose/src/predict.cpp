@@ -104,7 +104,7 @@ Prediction predictSighting(
 	m.P = primaryMeasurement(pr.corners_px, camera, &lambda);
 	pr.size_px = 2 * std::min(m.P[1], m.P[3]);
 	pr.big_enough = pr.size_px >= vis.min_size_px;
-	m.C_P = primaryCovariance(options.sigma_px, options.sigmaY());
+	m.C_P = options.primaryCovariance(m.P);
 	Eigen::Matrix<double, 3, 4> J_P;
 	Eigen::Matrix3d J_L;
 	m.L = landmarkFromPrimary(m.P, lambda, g.innerHalf(), &J_P);

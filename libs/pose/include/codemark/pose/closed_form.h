@@ -40,6 +40,17 @@ Eigen::Vector3d landmarkFromPrimary(
  * \param J_L if not null, receives the 3x3 Jacobian d(x, y, theta)/dL. */
 Eigen::Vector3d poseFromLandmark(const Eigen::Vector3d& L, Eigen::Matrix3d* J_L = nullptr);
 
+/** The covariance of the camera's planar pose (poseFromLandmark()) from that
+ * of L to second order: J_L C_L J_L^T (the spec's first order, paper eq.
+ * 15-16) plus 1/2 tr(H_i C_L H_j C_L), H_i the Hessian of pose component i
+ * (the exact covariance of a quadratic function of a Gaussian L). One
+ * landmark fixes the bearing phi1 far better than phi2, so the first-order
+ * C_R is nearly singular along "sideways position minus l2 times heading";
+ * beyond about 2 m the products of the l2 and phi2 errors and the curvature
+ * l2 dphi2^2 / 2 exceed that smallest sigma, and only this term keeps C_R
+ * honest there (docs/benchmarks/pose.md). */
+Eigen::Matrix3d poseCovarianceSecondOrder(const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L);
+
 /** C_P = diag(sx^2, sy^2, sx^2, sy^2): \a sigma_x_px, \a sigma_y_px are the
  * standard deviations of each component of P (not of each corner) [px]. */
 Eigen::Matrix4d primaryCovariance(double sigma_x_px, double sigma_y_px);

