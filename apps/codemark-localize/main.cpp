@@ -55,7 +55,7 @@ int main(int argc, char** argv)
 			"NAME", cmd);
 		TCLAP::ValueArg<std::string> gt("g", "gt",
 			"ground truth: 'timestamp x y yaw' rows (matched by timestamp) or an MRPT robot path "
-			"'x y z yaw pitch roll' (step i = row i + 1)", false, "", "GT.txt", cmd);
+			"'x y z yaw pitch roll' (row 0 = the start pose; in actions-observations rawlogs a frame matches the row of the number of actions before it, kf-slam's step i row i + 1; else step i = row i + 1)", false, "", "GT.txt", cmd);
 		TCLAP::ValueArg<std::string> gt_map("", "gt-map",
 			"ekf-slam: the true landmark map (spec section 3 or MRPT's x y z type 0 0 id) for the "
 			"landmark RMSE in summary.json", false, "", "MAP.txt", cmd);

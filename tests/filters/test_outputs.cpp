@@ -57,6 +57,22 @@ TEST(GroundTruth, MrptPathStepIMatchesRowIPlusOne)
 	EXPECT_FALSE(gt.poseAt(2, 0));
 }
 
+TEST(GroundTruth, MrptPathRowIsTheActionCountWhenGiven)
+{
+	const auto gt = GroundTruth::load(
+		writeText("path_actions.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
+	// A frame ahead of the first action: row 0, whatever its step index.
+	ASSERT_TRUE(gt.poseAt(0, 0, 1e-3, 0));
+	EXPECT_DOUBLE_EQ(gt.poseAt(0, 0, 1e-3, 0)->x(), 0.0);
+	// Step 1 after 1 action (the leading frame was step 0): row 1, not 2.
+	EXPECT_DOUBLE_EQ(gt.poseAt(1, 0, 1e-3, 1)->x(), 1.0);
+	EXPECT_DOUBLE_EQ(gt.poseAt(1, 0, 1e-3, 2)->x(), 2.0);
+	EXPECT_FALSE(gt.poseAt(0, 0, 1e-3, 3));
+	// The timestamped form ignores the action count.
+	const auto ts = GroundTruth::load(writeText("gt_actions.txt", "100.0 1 2 0.5\n"));
+	EXPECT_TRUE(ts.poseAt(5, 100.0, 1e-3, 0));
+}
+
 TEST(GroundTruth, BadRowsNameFileAndLine)
 {
 	try

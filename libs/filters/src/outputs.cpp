@@ -4,6 +4,7 @@
 #include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/exceptions.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/math/distributions.h>
 #include <mrpt/math/wrap2pi.h>
@@ -411,7 +412,18 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 			images += step.images_detected;
 			detect_s += std::chrono::duration<double>(t0 - t_read).count();
 		}
-		const StepStats st = filter->step(step.odometry.get(), step.observations);
+		StepStats st;
+		try
+		{
+			st = filter->step(step.odometry.get(), step.observations);
+		}
+		catch (const std::exception& e)
+		{
+			// A filter failure (non-finite or non-positive-definite state)
+			// names the rawlog entry that caused it.
+			throw std::runtime_error(req.rawlog + ": entry #" + std::to_string(step.entry) + " (step " +
+				std::to_string(step.index) + "): " + mrpt::exception_to_str(e));
+		}
 		const auto t1 = std::chrono::steady_clock::now();
 		filter_s += std::chrono::duration<double>(t1 - t0).count();
 		PathRow row;
@@ -419,7 +431,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		row.timestamp = step.timestamp;
 		row.estimate = filter->estimate();
 		row.stats = st;
-		if (gt) row.truth = gt->poseAt(step.index, step.timestamp);
+		if (gt) row.truth = gt->poseAt(step.index, step.timestamp, 1e-3, step.actions);
 		if (step.index == 0) first_t = step.timestamp;
 		if (row.estimate.initialized && s.first_fix_step < 0)
 		{
