@@ -85,7 +85,9 @@ int main(int argc, char** argv)
 		if (s.metrics)
 			std::cout << "; ATE " << s.metrics->ate_rmse_m << " m, yaw RMSE " << s.metrics->yaw_rmse_deg
 					  << " deg, mean NEES " << s.metrics->nees_mean
-					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth)" : "");
+					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth; " +
+								std::to_string(s.metrics->ate_rmse_anchored_m) + " m anchored at the true start)"
+											 : std::string());
 		std::cout << "; wrote " << req.out_dir << "\n";
 		return 0;
 	}

@@ -218,8 +218,18 @@ TEST(Metrics, AlignSE2RecoversARigidTransform)
 	EXPECT_NEAR(m->truth_T_estimate.x(), truth_T_est.x(), 1e-9);
 	EXPECT_NEAR(m->truth_T_estimate.y(), truth_T_est.y(), 1e-9);
 	EXPECT_NEAR(m->truth_T_estimate.phi(), truth_T_est.phi(), 1e-9);
+	// Anchored at the true first pose, a rigid copy has no error either...
+	EXPECT_LT(m->ate_rmse_anchored_m, 1e-9);
+	// ...but a yaw error at the start swings the anchored path away, which
+	// the least-squares fit partly absorbs.
+	auto bent = rows;
+	bent[0].estimate.mean = bent[0].estimate.mean + CPose2D(0, 0, 0.05);
+	const auto mb = computeMetrics(bent, true);
+	ASSERT_TRUE(mb);
+	EXPECT_GT(mb->ate_rmse_anchored_m, mb->ate_rmse_m);
 	LocalizeSummary ls;
 	ls.method = "ekf-slam";
 	ls.metrics = m;
 	EXPECT_NE(summaryJson(ls).find("\"alignment\": \"se2_least_squares\""), std::string::npos);
+	EXPECT_NE(summaryJson(ls).find("\"ate_rmse_anchored_m\""), std::string::npos);
 }

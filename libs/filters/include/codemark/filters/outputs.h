@@ -65,6 +65,10 @@ struct PathMetrics
 	 * start, where it is zero) but with the estimate's frame anchored at the
 	 * true first pose: truth_T_start = truth_0 (+) (-estimate_0). */
 	mrpt::poses::CPose2D truth_T_start;
+	/** When aligned: the RMS position error [m] in that anchored frame (no
+	 * fit), the figure kf-slam's users and bench/filters_slam compare (on
+	 * kf-slam_demo the true start is the origin: the raw estimate). */
+	double ate_rmse_anchored_m = 0;
 	/** SLAM with ground truth map: RMS of the landmark position error after
 	 * the same alignment [m], and the number of landmarks compared (0: none). */
 	double landmark_rmse_m = 0;
