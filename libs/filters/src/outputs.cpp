@@ -372,7 +372,8 @@ void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::s
 	j << summaryJson(s);
 }
 
-LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<void(double)>& progress)
+LocalizeSummary runLocalization(
+	const LocalizeRequest& req, const std::function<void(double)>& progress, const StepObserver& on_step)
 {
 	if (!std::ifstream(req.config_file).good())
 		throw std::runtime_error(req.config_file + ": cannot open config file");
@@ -449,6 +450,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		s.rows.push_back(std::move(row));
 		++s.steps;
 		if (progress) progress(stepper.progress());
+		if (on_step) on_step(s, map, *filter);
 		t_read = std::chrono::steady_clock::now();
 	}
 	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;

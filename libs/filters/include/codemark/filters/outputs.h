@@ -31,6 +31,15 @@ struct LocalizeRequest
 	std::string out_dir;  //!< output folder (created)
 };
 
+struct LocalizeSummary;
+
+/** Called after each step of runLocalization (live views): the summary so
+ * far (its rows up to this step; metrics not yet computed), the map in use
+ * (empty for SLAM without a prior map) and the filter (e.g. its
+ * landmarks()). */
+using StepObserver =
+	std::function<void(const LocalizeSummary& so_far, const LandmarkMap& map, const Localizer& filter)>;
+
 /** One processed camera frame. */
 struct PathRow
 {
@@ -110,8 +119,8 @@ mrpt::poses::CPose2D alignSE2(
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
  * with one line naming the file, line or entry on bad input. */
-LocalizeSummary runLocalization(
-	const LocalizeRequest& request, const std::function<void(double)>& progress = {});
+LocalizeSummary runLocalization(const LocalizeRequest& request,
+	const std::function<void(double)>& progress = {}, const StepObserver& on_step = {});
 
 /** Writes the output files of \a s into \a out_dir (created). \a map: the
  * map used (drawn in the plot and the 3D scene). */
