@@ -7,7 +7,9 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
+#include "live_view.h"
 #include "progress.h"
 
 namespace
@@ -55,18 +57,19 @@ int main(int argc, char** argv)
 			"NAME", cmd);
 		TCLAP::ValueArg<std::string> gt("g", "gt",
 			"ground truth: 'timestamp x y yaw' rows (matched by timestamp) or an MRPT robot path "
-			"'x y z yaw pitch roll' (step i = row i + 1)", false, "", "GT.txt", cmd);
+			"'x y z yaw pitch roll' (row 0 = the start pose; in actions-observations rawlogs a frame matches the row of the number of actions before it, kf-slam's step i row i + 1; else step i = row i + 1)", false, "", "GT.txt", cmd);
 		TCLAP::ValueArg<std::string> gt_map("", "gt-map",
 			"ekf-slam: the true landmark map (spec section 3 or MRPT's x y z type 0 0 id) for the "
 			"landmark RMSE in summary.json", false, "", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> out("o", "out", "output directory (created)", true, "", "DIR", cmd);
-		TCLAP::SwitchArg gui("", "gui", "live view (not available in this build: prints a note and runs without)", cmd);
+		TCLAP::SwitchArg gui("", "gui",
+			"live 3D view while running (estimate, ground truth, landmarks, current pose with its 95% ellipse); "
+			"needs an X display (e.g. xvfb-run -a)", cmd);
+		TCLAP::ValueArg<int> gui_every("", "gui-every", "--gui: redraw every N steps (default 10)", false, 10, "N", cmd);
+		TCLAP::SwitchArg gui_wait("", "gui-wait", "--gui: at the end, wait for a key in the window", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
-		if (gui.getValue())
-			std::cerr << "codemark-localize: --gui is not available in this build; open "
-					  << out.getValue() << "/trajectory.3Dscene with SceneViewer3D afterwards\n";
 		codemark::filters::LocalizeRequest req;
 		req.config_file = config.getValue();
 		req.rawlog = rawlog.getValue();
@@ -75,17 +78,44 @@ int main(int argc, char** argv)
 		req.gt_file = gt.getValue();
 		req.gt_map_file = gt_map.getValue();
 		req.out_dir = out.getValue();
+		if (gui_every.getValue() < 1) throw std::invalid_argument("--gui-every must be >= 1");
+		std::unique_ptr<codemark::app::LiveView> view;
+		if (gui.getValue())
+		{
+			std::optional<codemark::filters::GroundTruth> gt_path;
+			if (!req.gt_file.empty()) gt_path = codemark::filters::GroundTruth::load(req.gt_file);
+			view = std::make_unique<codemark::app::LiveView>(gui_every.getValue(), gt_path);
+		}
+		codemark::filters::StepObserver on_step;
+		if (view)
+			on_step = [&](const codemark::filters::LocalizeSummary& so_far, const codemark::LandmarkMap& m,
+						  const codemark::filters::Localizer& f) { view->update(so_far, m, f); };
 		codemark::app::ProgressBar bar("codemark-localize", !quiet.getValue());
+		codemark::LandmarkMap used_map;
 		const auto s = codemark::filters::runLocalization(
-			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); });
+			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); },
+			view ? codemark::filters::StepObserver(
+					   [&](const codemark::filters::LocalizeSummary& so_far, const codemark::LandmarkMap& m,
+						   const codemark::filters::Localizer& f) {
+						   used_map = m;
+						   on_step(so_far, m, f);
+					   })
+				 : codemark::filters::StepObserver());
 		bar.finish();
+		if (view)
+		{
+			view->finish(s, used_map, false);
+			if (gui_wait.getValue()) view->finish(s, used_map, true);
+		}
 		std::cout << "codemark-localize: " << s.method << ", " << s.steps << " steps, "
 				  << s.sightings_used << " sightings used, " << s.sightings_rejected << " rejected, "
 				  << s.sightings_unknown_id << " unknown IDs, " << s.time_per_step_ms << " ms/step";
 		if (s.metrics)
 			std::cout << "; ATE " << s.metrics->ate_rmse_m << " m, yaw RMSE " << s.metrics->yaw_rmse_deg
 					  << " deg, mean NEES " << s.metrics->nees_mean
-					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth)" : "");
+					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth; " +
+								std::to_string(s.metrics->ate_rmse_anchored_m) + " m anchored at the true start)"
+											 : std::string());
 		std::cout << "; wrote " << req.out_dir << "\n";
 		return 0;
 	}

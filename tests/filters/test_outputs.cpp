@@ -57,6 +57,22 @@ TEST(GroundTruth, MrptPathStepIMatchesRowIPlusOne)
 	EXPECT_FALSE(gt.poseAt(2, 0));
 }
 
+TEST(GroundTruth, MrptPathRowIsTheActionCountWhenGiven)
+{
+	const auto gt = GroundTruth::load(
+		writeText("path_actions.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
+	// A frame ahead of the first action: row 0, whatever its step index.
+	ASSERT_TRUE(gt.poseAt(0, 0, 1e-3, 0));
+	EXPECT_DOUBLE_EQ(gt.poseAt(0, 0, 1e-3, 0)->x(), 0.0);
+	// Step 1 after 1 action (the leading frame was step 0): row 1, not 2.
+	EXPECT_DOUBLE_EQ(gt.poseAt(1, 0, 1e-3, 1)->x(), 1.0);
+	EXPECT_DOUBLE_EQ(gt.poseAt(1, 0, 1e-3, 2)->x(), 2.0);
+	EXPECT_FALSE(gt.poseAt(0, 0, 1e-3, 3));
+	// The timestamped form ignores the action count.
+	const auto ts = GroundTruth::load(writeText("gt_actions.txt", "100.0 1 2 0.5\n"));
+	EXPECT_TRUE(ts.poseAt(5, 100.0, 1e-3, 0));
+}
+
 TEST(GroundTruth, BadRowsNameFileAndLine)
 {
 	try
@@ -202,8 +218,18 @@ TEST(Metrics, AlignSE2RecoversARigidTransform)
 	EXPECT_NEAR(m->truth_T_estimate.x(), truth_T_est.x(), 1e-9);
 	EXPECT_NEAR(m->truth_T_estimate.y(), truth_T_est.y(), 1e-9);
 	EXPECT_NEAR(m->truth_T_estimate.phi(), truth_T_est.phi(), 1e-9);
+	// Anchored at the true first pose, a rigid copy has no error either...
+	EXPECT_LT(m->ate_rmse_anchored_m, 1e-9);
+	// ...but a yaw error at the start swings the anchored path away, which
+	// the least-squares fit partly absorbs.
+	auto bent = rows;
+	bent[0].estimate.mean = bent[0].estimate.mean + CPose2D(0, 0, 0.05);
+	const auto mb = computeMetrics(bent, true);
+	ASSERT_TRUE(mb);
+	EXPECT_GT(mb->ate_rmse_anchored_m, mb->ate_rmse_m);
 	LocalizeSummary ls;
 	ls.method = "ekf-slam";
 	ls.metrics = m;
 	EXPECT_NE(summaryJson(ls).find("\"alignment\": \"se2_least_squares\""), std::string::npos);
+	EXPECT_NE(summaryJson(ls).find("\"ate_rmse_anchored_m\""), std::string::npos);
 }

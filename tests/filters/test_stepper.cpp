@@ -170,6 +170,45 @@ TEST(Stepper, ActionsObservationsComposesTheActionsSinceTheLastFrame)
 	EXPECT_TRUE(st.actionsObservationsFormat());
 }
 
+// MRPT robot-path ground truth: row 0 is the start pose, row k the pose
+// after k actions. A sensory frame ahead of the first action (kf-slam_demo
+// has one; kf-slam skips it) is taken at row 0; a frame without camera
+// observations still counts its action.
+TEST(Stepper, ActionsObservationsStepsCountTheActionsBeforeThem)
+{
+	auto act = [](const CPose2D& u) {
+		auto ac = mrpt::obs::CActionCollection::Create();
+		ac->insert(odometry(u, 0.01, 0.02));
+		return ac;
+	};
+	auto sf = [](double t) {
+		auto f = mrpt::obs::CSensoryFrame::Create();
+		f->insert(landmarksAt(t));
+		return f;
+	};
+	const CPose2D u(0.1, 0, 0);
+	const std::string path = tempFile("actions_count.rawlog");
+	writeRawlog(path, {sf(kT0), act(u), sf(kT0 + 1), act(u), mrpt::obs::CSensoryFrame::Create(), act(u),
+						  sf(kT0 + 3)});
+	RawlogStepper st(path);
+	RawlogStep s;
+	std::vector<long> actions, indices;
+	while (st.next(s))
+	{
+		actions.push_back(s.actions);
+		indices.push_back(s.index);
+	}
+	EXPECT_EQ(actions, (std::vector<long>{0, 1, 3}));
+	EXPECT_EQ(indices, (std::vector<long>{0, 1, 2}));
+
+	// Observations-only rawlogs have no actions.
+	const std::string obs_only = tempFile("obs_only_count.rawlog");
+	writeRawlog(obs_only, {landmarksAt(kT0), landmarksAt(kT0 + 1)});
+	RawlogStepper st2(obs_only);
+	ASSERT_TRUE(st2.next(s));
+	EXPECT_EQ(s.actions, -1);
+}
+
 TEST(Stepper, AnnotatedImagesAreNotDetectedAgainButBareOnesAre)
 {
 	auto img = mrpt::obs::CObservationImage::Create();

@@ -1,16 +1,22 @@
 // The coded-landmark map (CCodedLandmarksMap) and the particle filter.
+#include <codemark/filters/outputs.h>
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <gtest/gtest.h>
 
 #include "../common/serialization_io.h"
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/io/vector_loadsave.h>
 #include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/opengl/CSetOfObjects.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -351,6 +357,94 @@ TEST(ParticleFilter, CountsUnknownIdsAndRejectsWrongSightings)
 	EXPECT_EQ(st.rejected, 1);
 	EXPECT_EQ(st.used, static_cast<int>(good));
 	EXPECT_LT(positionError(f->estimate(), truth), 0.10);
+}
+
+// A huge but finite odometry increment passes the stepper's input checks;
+// the particles then overflow: a clear error, not a NaN estimate.
+TEST(ParticleFilter, NonFiniteParticlesOrCovarianceThrow)
+{
+	auto cfg = shippedConfig(1);
+	codemark::filters::PoseEstimate start;
+	start.initialized = true;
+	start.mean = kPose;
+	start.cov = Eigen::Matrix3d::Identity() * 1e-4;
+	const auto f = codemark::filters::makeLocalizer("pf", cfg, pft::room(), start);
+	mrpt::obs::CActionRobotMovement2D act;
+	mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
+	mm.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
+	// Noise independent of the distance, so that the action's own
+	// covariance stays finite (MRPT ignores an action with an infinite one).
+	mm.gaussianModel.a1 = mm.gaussianModel.a2 = mm.gaussianModel.a3 = mm.gaussianModel.a4 = 0;
+	mm.gaussianModel.minStdXY = 0.01;
+	mm.gaussianModel.minStdPHI = 0.01;
+	act.computeFromOdometry(CPose2D(0.1, 0, 0), mm);
+	mrpt::obs::CSensoryFrame none;
+	EXPECT_NO_THROW(f->step(&act, none));
+	// Steps of 1e308 m with a small, finite covariance (set directly: MRPT's
+	// motion models overflow on such a distance): the particles' spread and
+	// then their positions overflow.
+	act.poseChange = mrpt::poses::CPosePDFGaussian::Create(
+		CPose2D(1e308, 0, 0), mrpt::math::CMatrixDouble33(Eigen::Matrix3d::Identity() * 1e-4));
+	try
+	{
+		f->step(&act, none);
+		f->step(&act, none);
+		ADD_FAILURE() << "no error on an overflowing particle set";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("pf: "), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+	}
+}
+
+// The same through codemark-localize's run: the error names the rawlog
+// entry (the app prints it on one line and exits 1).
+TEST(ParticleFilter, NonFiniteStateInARunNamesTheRawlogEntry)
+{
+	const std::string dir = mrpt::system::getTempFileName() + "_pf_nonfinite_" + std::to_string(getpid());
+	mrpt::system::createDirectory(dir);
+	pft::room().save(dir + "/map.txt");
+	const std::string rawlog = dir + "/in.rawlog";
+	{
+		mrpt::io::CFileGZOutputStream f(rawlog);
+		auto ar = mrpt::serialization::archiveFrom(f);
+		for (int k = 0; k < 4; ++k)
+		{
+			mrpt::obs::CActionCollection acts;
+			mrpt::obs::CActionRobotMovement2D a;
+			a.computeFromOdometry(CPose2D(0.05, 0, 0), pft::motionModel());
+			if (k == 2)  // entry #4: finite, absurd (not odometry: MRPT would
+			{  // recompute the PDF from the raw reading when reading it)
+				a.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
+				a.poseChange = mrpt::poses::CPosePDFGaussian::Create(
+					CPose2D(1e308, 0, 0), mrpt::math::CMatrixDouble33(Eigen::Matrix3d::Identity() * 1e-4));
+			}
+			acts.insert(a);
+			ar << acts;
+			mrpt::obs::CSensoryFrame sf;
+			sf.insert(pft::observe(kPose, pft::room(), nullptr, 0.2 * k));
+			ar << sf;
+		}
+	}
+	codemark::filters::LocalizeRequest req;
+	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/pf.ini";
+	req.method = "pf";
+	req.rawlog = rawlog;
+	req.map_file = dir + "/map.txt";
+	try
+	{
+		codemark::filters::runLocalization(req);
+		ADD_FAILURE() << "no error: " << dir;
+		return;
+	}
+	catch (const std::exception& e)
+	{
+		const std::string m = e.what();
+		EXPECT_NE(m.find("in.rawlog: entry #5"), std::string::npos) << m;
+		EXPECT_NE(m.find("non-finite"), std::string::npos) << m;
+	}
+	mrpt::system::deleteFilesInDirectory(dir, true);
 }
 
 TEST(ParticleFilter, BadConfigurationThrows)

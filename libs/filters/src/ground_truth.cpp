@@ -52,11 +52,11 @@ GroundTruth GroundTruth::load(const std::string& path)
 	return gt;
 }
 
-std::optional<mrpt::poses::CPose2D> GroundTruth::poseAt(long index, double t, double tol) const
+std::optional<mrpt::poses::CPose2D> GroundTruth::poseAt(long index, double t, double tol, long actions) const
 {
 	if (form_ == Form::MrptPath)
 	{
-		const long row = index + 1;
+		const long row = actions >= 0 ? actions : index + 1;
 		if (row < 0 || row >= static_cast<long>(poses_.size())) return std::nullopt;
 		return poses_[row];
 	}

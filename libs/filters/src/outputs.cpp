@@ -4,6 +4,7 @@
 #include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/exceptions.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/math/distributions.h>
 #include <mrpt/math/wrap2pi.h>
@@ -65,7 +66,7 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 		for (const auto& r : rows)
 			if (r.estimate.initialized && r.truth)
 			{
-				if (a.empty()) m.truth_T_start = *r.truth - r.estimate.mean;
+				if (a.empty()) m.truth_T_start = *r.truth + (CPose2D() - r.estimate.mean);  // truth_0 (+) estimate_0^-1
 				a.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
 				b.emplace_back(r.truth->x(), r.truth->y());
 			}
@@ -87,7 +88,7 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 		return Eigen::Vector3d(est.x() - r.truth->x(), est.y() - r.truth->y(),
 			mrpt::math::wrapToPi(est.phi() - r.truth->phi()));
 	};
-	double se = 0, syaw = 0, snees = 0;
+	double se = 0, syaw = 0, snees = 0, sanchored = 0;
 	for (const auto& r : rows)
 	{
 		if (!r.estimate.initialized || !r.truth) continue;
@@ -99,12 +100,14 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 		Eigen::Matrix3d cov;
 		const Eigen::Vector3d en = error(r, m.aligned ? m.truth_T_start : m.truth_T_estimate, &cov);
 		snees += en.dot(cov.ldlt().solve(en));
+		sanchored += en[0] * en[0] + en[1] * en[1];
 		++m.matched;
 	}
 	if (m.matched == 0) return std::nullopt;
 	m.ate_rmse_m = std::sqrt(se / m.matched);
 	m.yaw_rmse_deg = std::sqrt(syaw / m.matched) * 180.0 / M_PI;
 	m.nees_mean = snees / m.matched;
+	if (m.aligned) m.ate_rmse_anchored_m = std::sqrt(sanchored / m.matched);
 	const unsigned dof = 3u * static_cast<unsigned>(m.matched);
 	m.nees_band_low = mrpt::math::chi2inv(0.025, dof) / m.matched;
 	m.nees_band_high = mrpt::math::chi2inv(0.975, dof) / m.matched;
@@ -342,6 +345,7 @@ std::string summaryJson(const LocalizeSummary& s)
 			o << "  \"alignment_truth_T_estimate\": [" << num(m.truth_T_estimate.x(), 6) << ", "
 			  << num(m.truth_T_estimate.y(), 6) << ", " << num(m.truth_T_estimate.phi(), 6) << "],\n";
 			o << "  \"nees_frame\": \"anchored_at_true_first_pose\",\n";
+			o << "  \"ate_rmse_anchored_m\": " << num(m.ate_rmse_anchored_m, 6) << ",\n";
 		}
 		if (m.landmarks_matched > 0)
 		{
@@ -368,7 +372,8 @@ void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::s
 	j << summaryJson(s);
 }
 
-LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<void(double)>& progress)
+LocalizeSummary runLocalization(
+	const LocalizeRequest& req, const std::function<void(double)>& progress, const StepObserver& on_step)
 {
 	if (!std::ifstream(req.config_file).good())
 		throw std::runtime_error(req.config_file + ": cannot open config file");
@@ -411,7 +416,18 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 			images += step.images_detected;
 			detect_s += std::chrono::duration<double>(t0 - t_read).count();
 		}
-		const StepStats st = filter->step(step.odometry.get(), step.observations);
+		StepStats st;
+		try
+		{
+			st = filter->step(step.odometry.get(), step.observations);
+		}
+		catch (const std::exception& e)
+		{
+			// A filter failure (non-finite or non-positive-definite state)
+			// names the rawlog entry that caused it.
+			throw std::runtime_error(req.rawlog + ": entry #" + std::to_string(step.entry) + " (step " +
+				std::to_string(step.index) + "): " + mrpt::exception_to_str(e));
+		}
 		const auto t1 = std::chrono::steady_clock::now();
 		filter_s += std::chrono::duration<double>(t1 - t0).count();
 		PathRow row;
@@ -419,7 +435,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		row.timestamp = step.timestamp;
 		row.estimate = filter->estimate();
 		row.stats = st;
-		if (gt) row.truth = gt->poseAt(step.index, step.timestamp);
+		if (gt) row.truth = gt->poseAt(step.index, step.timestamp, 1e-3, step.actions);
 		if (step.index == 0) first_t = step.timestamp;
 		if (row.estimate.initialized && s.first_fix_step < 0)
 		{
@@ -434,6 +450,7 @@ LocalizeSummary runLocalization(const LocalizeRequest& req, const std::function<
 		s.rows.push_back(std::move(row));
 		++s.steps;
 		if (progress) progress(stepper.progress());
+		if (on_step) on_step(s, map, *filter);
 		t_read = std::chrono::steady_clock::now();
 	}
 	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;

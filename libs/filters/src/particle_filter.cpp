@@ -264,6 +264,7 @@ StepStats ParticleFilterLocalizer::step(
 
 	// Convergence (sticky) and the sightings the estimate rejects.
 	const PoseEstimate e = estimate();
+	checkFinite(e);
 	if (!m_converged)
 	{
 		const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(e.cov.topLeftCorner<2, 2>());
@@ -342,6 +343,26 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 	m_pdf.normalizeWeights();
 	++m_injections;
 	return true;
+}
+
+// MRPT's particle filter checks nothing: an overflowing motion (e.g. a huge
+// but finite odometry increment) or a likelihood that turns NaN would leave
+// a silently wrong estimate. The caller adds the rawlog entry to the message.
+void ParticleFilterLocalizer::checkFinite(const PoseEstimate& e) const
+{
+	const auto& parts = m_pdf.m_particles;
+	for (std::size_t i = 0; i < parts.size(); ++i)
+	{
+		const auto& p = parts[i];
+		if (!std::isfinite(p.d.x) || !std::isfinite(p.d.y) || !std::isfinite(p.d.phi) || std::isnan(p.log_w))
+			throw std::runtime_error("pf: particle #" + std::to_string(i) + " of " +
+				std::to_string(parts.size()) + " became non-finite (pose " + p.d.asString() +
+				", log-weight " + std::to_string(p.log_w) + ")");
+	}
+	if (!std::isfinite(e.mean.x()) || !std::isfinite(e.mean.y()) || !std::isfinite(e.mean.phi()))
+		throw std::runtime_error("pf: the estimate became non-finite: " + e.mean.asString());
+	if (!e.cov.allFinite())
+		throw std::runtime_error("pf: the estimate's covariance became non-finite (particle spread overflows)");
 }
 
 PoseEstimate ParticleFilterLocalizer::estimate() const

@@ -110,6 +110,7 @@ struct RawlogStepper::Impl
 	long total_bytes = 0;
 	long entries = 0;
 	long steps = 0;
+	long actions_read = 0;  // CActionCollection entries so far
 	bool eof = false;
 	bool actions_observations = false;
 
@@ -155,6 +156,7 @@ struct RawlogStepper::Impl
 		else if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj))
 		{
 			actions_observations = true;
+			++actions_read;
 			onActions(*acts, entry);
 		}
 		else if (auto o = std::dynamic_pointer_cast<CObservation>(obj))
@@ -353,6 +355,7 @@ struct RawlogStepper::Impl
 		RawlogStep s;
 		s.index = steps++;
 		s.entry = f.entry;
+		s.actions = actions_observations ? actions_read : -1;
 		s.has_timestamp = f.stamp != INVALID_TIMESTAMP;
 		s.timestamp = s.has_timestamp ? mrpt::Clock::toDouble(f.stamp) : static_cast<double>(s.index);
 		s.odometry = odo;

@@ -5,8 +5,12 @@
  *  - `timestamp x y yaw` rows (UNIX s, m, m, rad; `#` or `%` comments):
  *    matched to steps by timestamp (codemark-simul's gt_path.txt);
  *  - MRPT robot-path files, `x y z yaw pitch roll` rows with `%` comments
- *    (e.g. kf-slam_demo's ground truth), whose row 0 is the start pose:
- *    step i matches row i + 1.
+ *    (e.g. kf-slam_demo's ground truth), whose row 0 is the start pose and
+ *    row k the pose after k actions: an actions-observations step matches
+ *    the row of the number of actions read before it (kf-slam's step i, its
+ *    (i+1)-th action-observation pair, row i + 1; a sensory frame ahead of
+ *    the first action, which kf-slam skips, row 0); in observations-only
+ *    rawlogs step i matches row i + 1.
  */
 #include <mrpt/poses/CPose2D.h>
 
@@ -32,10 +36,13 @@ class GroundTruth
 	static GroundTruth load(const std::string& path);
 
 	/** The true pose at step \a index with timestamp \a t [UNIX s]: by
-	 * timestamp (nearest row within \a tolerance_s) or by row index + 1.
-	 * None when there is no matching row. */
+	 * timestamp (nearest row within \a tolerance_s), or in an MRPT path by
+	 * row \a actions when it is >= 0 (RawlogStep::actions: the actions read
+	 * so far in an actions-observations rawlog, so that a sensory frame ahead
+	 * of the first action matches row 0 and kf-slam's step i row i + 1), else
+	 * by row index + 1. None when there is no matching row. */
 	std::optional<mrpt::poses::CPose2D> poseAt(
-		long index, double t, double tolerance_s = 1e-3) const;
+		long index, double t, double tolerance_s = 1e-3, long actions = -1) const;
 
 	Form form() const { return form_; }
 	std::size_t size() const { return poses_.size(); }

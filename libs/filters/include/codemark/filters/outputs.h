@@ -31,6 +31,15 @@ struct LocalizeRequest
 	std::string out_dir;  //!< output folder (created)
 };
 
+struct LocalizeSummary;
+
+/** Called after each step of runLocalization (live views): the summary so
+ * far (its rows up to this step; metrics not yet computed), the map in use
+ * (empty for SLAM without a prior map) and the filter (e.g. its
+ * landmarks()). */
+using StepObserver =
+	std::function<void(const LocalizeSummary& so_far, const LandmarkMap& map, const Localizer& filter)>;
+
 /** One processed camera frame. */
 struct PathRow
 {
@@ -65,6 +74,10 @@ struct PathMetrics
 	 * start, where it is zero) but with the estimate's frame anchored at the
 	 * true first pose: truth_T_start = truth_0 (+) (-estimate_0). */
 	mrpt::poses::CPose2D truth_T_start;
+	/** When aligned: the RMS position error [m] in that anchored frame (no
+	 * fit), the figure kf-slam's users and bench/filters_slam compare (on
+	 * kf-slam_demo the true start is the origin: the raw estimate). */
+	double ate_rmse_anchored_m = 0;
 	/** SLAM with ground truth map: RMS of the landmark position error after
 	 * the same alignment [m], and the number of landmarks compared (0: none). */
 	double landmark_rmse_m = 0;
@@ -106,8 +119,8 @@ mrpt::poses::CPose2D alignSE2(
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
  * with one line naming the file, line or entry on bad input. */
-LocalizeSummary runLocalization(
-	const LocalizeRequest& request, const std::function<void(double)>& progress = {});
+LocalizeSummary runLocalization(const LocalizeRequest& request,
+	const std::function<void(double)>& progress = {}, const StepObserver& on_step = {});
 
 /** Writes the output files of \a s into \a out_dir (created). \a map: the
  * map used (drawn in the plot and the 3D scene). */

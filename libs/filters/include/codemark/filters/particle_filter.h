@@ -101,6 +101,10 @@ class ParticleFilterLocalizer : public Localizer
 	bool injectAroundFixes(const mrpt::obs::CSensoryFrame& observations);
 
    private:
+	/** Throws std::runtime_error when a particle's pose or log-weight, or the
+	 * estimate \a e (mean, covariance), is not finite; step() calls it. */
+	void checkFinite(const PoseEstimate& e) const;
+
 	ParticleFilterOptions m_opts;
 	std::shared_ptr<CCodedLandmarksMap> m_map;
 	mrpt::slam::CMonteCarloLocalization2D m_pdf;

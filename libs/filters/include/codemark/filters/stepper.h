@@ -64,6 +64,13 @@ struct RawlogStep
 	/** UNIX time [s] of the frame; the step index when the rawlog has none. */
 	double timestamp = 0;
 	bool has_timestamp = false;  //!< false: timestamp is the step index
+	/** Actions-observations format: the number of CActionCollection entries
+	 * read before this frame (0 for a sensory frame ahead of the first
+	 * action, i.e. taken at the start pose). It indexes an MRPT robot-path
+	 * ground truth, whose row 0 is the start pose and row k the pose after
+	 * k actions (kf-slam's step i, the (i+1)-th action-observation pair,
+	 * matches row i + 1). -1 in the observations-only format. */
+	long actions = -1;
 	/** Robot motion since the previous step (null: none known, e.g. the
 	 * first step or a rawlog without odometry). */
 	mrpt::obs::CActionRobotMovement2D::Ptr odometry;
