@@ -219,7 +219,7 @@ JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& m
 			row.timestamp = step.timestamp;
 			row.estimate = filter->estimate();
 			row.stats = st;
-			row.truth = gt.poseAt(step.index, step.timestamp);
+			row.truth = gt.poseAt(step.index, step.timestamp, 1e-3, step.actions);
 			if (row.truth && !mrpt_map)
 				for (const auto& o : step.observations)
 					if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
