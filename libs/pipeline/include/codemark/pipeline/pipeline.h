@@ -32,30 +32,35 @@ namespace codemark::pipeline
  * below the camera), detects them, compares P from the detected corners
  * with P from the renderer's exact corners, and fits the model by maximum
  * likelihood (1054 detections of 1200 renders):
- * - x1, x2 (whole-edge line fits): 0.040 px, growing as
- *   (30 px / apparent width)^2 with 0.055 px at 30 px (the black frame is
- *   then a few pixels wide and its two blurred edges pull on each other);
- *   x1 and x2 anti-correlated, -0.55 in the constant part and -0.90 in the
- *   growing part (the apparent width grows or shrinks);
+ * - x1, x2 (whole-edge line fits), re-fitted after the detector learnt to
+ *   model the frame's outer edge on thin frames (1062 detections of the same
+ *   1200 renders): 0.0375 px, growing as (30 px / apparent width)^1.25 with
+ *   0.040 px at 30 px (the black frame is then a few pixels wide and its two
+ *   blurred edges pull on each other); x1 and x2 anti-correlated, -0.80 in
+ *   the constant part and -0.50 in the growing part;
  * - y1, y2: 0.040 px, growing as (30 px / apparent height)^1.25 with
  *   0.055 px at 30 px; correlated +0.85 in the constant part and +0.55 in
  *   the growing part (both half-lengths grow or shrink together: a range
- *   error rather than a phi2 error).
- * Normalised variances on the calibration set: 1.01 (x), 1.02 (y). The
+ *   error rather than a phi2 error). Kept from the first calibration: the
+ *   re-run fits y at a constant 0.054 px with corr(y1, y2) +0.43, which
+ *   under-predicts the range error on the simulated loop (7 of 99 ranges
+ *   beyond 3 sigma, biased short at >= 2 m, test_annotate.cpp), so the
+ *   larger common-mode model stays until the two sets agree.
+ * Normalised variances on the calibration set: 0.98 (x, re-fit), 1.02 (y). The
  * closed form's C_R is taken to second order in C_L
  * (pose::poseCovarianceSecondOrder()). Checked on other renders and seeds
  * by tests/pipeline/test_pose_nees.cpp and test_annotate.cpp. On a flat
  * grey background the detector is about twice as good (constant parts 0.010
  * and 0.0125 px): these values are conservative there. Re-run the
  * calibration (scripts/bench-accuracy.sh) when the detector changes. */
-constexpr double kDetectorSigmaXPx = 0.040;  //!< constant part of sigma(x1), sigma(x2) [px]
+constexpr double kDetectorSigmaXPx = 0.0375;  //!< constant part of sigma(x1), sigma(x2) [px]
 constexpr double kDetectorSigmaYPx = 0.040;  //!< constant part of sigma(y1), sigma(y2) [px]
-constexpr double kDetectorGrowthXPx = 0.055;  //!< sigma(x) growth term at 30 px apparent width [px]
+constexpr double kDetectorGrowthXPx = 0.040;  //!< sigma(x) growth term at 30 px apparent width [px]
 constexpr double kDetectorGrowthYPx = 0.055;  //!< sigma(y) growth term at 30 px apparent height [px]
-constexpr double kDetectorSizeExponentX = 2.0;  //!< exponent of the x growth
+constexpr double kDetectorSizeExponentX = 1.25;  //!< exponent of the x growth
 constexpr double kDetectorSizeExponentY = 1.25;  //!< exponent of the y growth
-constexpr double kDetectorCorrX12 = -0.55;  //!< corr(x1, x2), constant part
-constexpr double kDetectorCorrGrowthX12 = -0.90;  //!< corr(x1, x2), growing part
+constexpr double kDetectorCorrX12 = -0.80;  //!< corr(x1, x2), constant part
+constexpr double kDetectorCorrGrowthX12 = -0.50;  //!< corr(x1, x2), growing part
 constexpr double kDetectorCorrY12 = 0.85;  //!< corr(y1, y2), constant part
 constexpr double kDetectorCorrGrowthY12 = 0.55;  //!< corr(y1, y2), growing part
 
