@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "errors.h"
 #include "progress.h"
 
 int main(int argc, char** argv)
@@ -90,7 +91,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-annotate: error: " << mrpt::exception_to_str(e) << "\n";
+		std::cerr << "codemark-annotate: error: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
 	}
 	return 1;
 }

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "errors.h"
 #include "progress.h"
 
 namespace
@@ -28,28 +29,13 @@ codemark::sim::RenderOptions demoOptions()
 	return o;
 }
 
-/** One line out of an exception message: MRPT's exceptions carry a banner
- * and a call stack that say nothing to a user. */
-std::string oneLine(const std::string& what)
-{
-	std::string msg = what;
-	const auto stack = msg.find("Call stack backtrace");
-	if (stack != std::string::npos) msg.resize(stack);
-	std::string out, line;
-	std::istringstream in(msg);
-	while (std::getline(in, line))
-	{
-		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos) continue;
-		out += (out.empty() ? "" : "; ") + line;
-	}
-	return out.empty() ? what : out;
-}
 }  // namespace
 
 int main(int argc, char** argv)
 {
 	namespace fs = std::filesystem;
 	using namespace codemark;
+	using app::oneLine;
 	try
 	{
 		TCLAP::CmdLine cmd(

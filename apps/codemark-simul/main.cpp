@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "errors.h"
 #include "progress.h"
 
 int main(int argc, char** argv)
@@ -62,7 +63,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-simul: " << mrpt::exception_to_str(e) << "\n";
+		std::cerr << "codemark-simul: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
 	}
 	return 1;
 }
