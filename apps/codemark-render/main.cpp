@@ -1,5 +1,6 @@
 // codemark-render: renders camera frames of a landmark map with exact ground
 // truth (the demo's render step). A thin main over codemark::sim.
+#include <codemark/landmark/text.h>
 #include <codemark/sim/frames.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
@@ -113,9 +114,9 @@ int main(int argc, char** argv)
 			{
 				options.loadFromConfigFile(cfg, sectionArg.getValue());
 			}
-			catch (const std::exception& e)
+			catch (const std::exception&)
 			{
-				throw std::runtime_error(optionsArg.getValue() + " [" + sectionArg.getValue() + "]: " + e.what());
+				rethrowNamingIniFile(optionsArg.getValue());
 			}
 		}
 

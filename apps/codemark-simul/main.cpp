@@ -1,5 +1,6 @@
 // codemark-simul: writes a simulated MRPT dataset (rawlog with external
 // images, map, ground truth) from an ini file.
+#include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
@@ -43,7 +44,14 @@ int main(int argc, char** argv)
 			if (!std::ifstream(config.getValue()).good())
 				throw std::runtime_error(config.getValue() + ": cannot open config file");
 			mrpt::config::CConfigFile cfg(config.getValue());
-			opts.loadFromConfigFile(cfg, "");
+			try
+			{
+				opts.loadFromConfigFile(cfg, "");
+			}
+			catch (const std::exception&)
+			{
+				codemark::rethrowNamingIniFile(config.getValue());
+			}
 		}
 		if (seed.isSet()) opts.seed = seed.getValue();
 		codemark::app::ProgressBar bar("codemark-simul", !quiet.getValue());

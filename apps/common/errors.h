@@ -22,7 +22,12 @@ inline std::string oneLine(const std::string& what)
 	while (std::getline(in, line))
 	{
 		while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos) continue;
+		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos ||
+			line.find("==== non-MRPT exception ====") != std::string::npos)
+			continue;
+		// MRPT: "Message:  WHAT" then "Location: FILE:LINE: [function]": keep WHAT.
+		if (line.rfind("Location:", 0) == 0) continue;
+		if (line.rfind("Message:", 0) == 0) line = line.substr(line.find_first_not_of(" ", 8));
 		out += (out.empty() ? "" : "; ") + line;
 	}
 	return out.empty() ? what : out;
