@@ -189,7 +189,7 @@ mrpt::img::TCamera loadRosYaml(const std::string& path)
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + ": cannot parse YAML: " + e.what());
+		throw std::runtime_error(path + ": cannot parse YAML: " + oneLineMessage(e.what()));
 	}
 	// libfyaml's "<memory-@0x...>:LINE:COL: error: MESSAGE" -> "PATH:LINE:COL: error: MESSAGE".
 	if (const auto err = diagnostics.find(": error: "); err != std::string::npos)
@@ -225,7 +225,7 @@ mrpt::img::TCamera loadRosYaml(const std::string& path)
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + ": bad camera YAML: " + e.what());
+		throw std::runtime_error(path + ": bad camera YAML: " + oneLineMessage(e.what()));
 	}
 }
 
@@ -266,7 +266,7 @@ mrpt::img::TCamera loadIni(
 	catch (const std::exception& e)
 	{
 		throw std::runtime_error(
-			path + ": [" + section + "]: " + mrpt::exception_to_str(e));
+			path + ": [" + section + "]: " + oneLineMessage(mrpt::exception_to_str(e)));
 	}
 	return c;
 }

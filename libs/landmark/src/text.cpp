@@ -86,6 +86,24 @@ std::string iniWhere(const std::string& file, const std::string& section, const 
 	return file + ": ";
 }
 
+std::string oneLineMessage(const std::string& what)
+{
+	std::string msg = what;
+	if (const auto stack = msg.find("Call stack backtrace"); stack != std::string::npos)
+		msg.resize(stack);
+	std::string joined;
+	std::istringstream lines(msg);
+	for (std::string l; std::getline(lines, l);)
+	{
+		l = trim(l);
+		if (l.empty() || l.find("exception ====") != std::string::npos) continue;
+		if (l.rfind("Location:", 0) == 0) continue;
+		if (l.rfind("Message:", 0) == 0) l = trim(l.substr(8));
+		joined += (joined.empty() ? "" : "; ") + l;
+	}
+	return joined.empty() ? trim(what) : joined;
+}
+
 void rethrowNamingIniFile(const std::string& file)
 {
 	try
@@ -100,20 +118,11 @@ void rethrowNamingIniFile(const std::string& file)
 	}
 	catch (const std::exception& e)
 	{
-		// One line: MRPT's exceptions add a banner and a call stack.
-		std::string msg = e.what();
-		if (const auto stack = msg.find("Call stack backtrace"); stack != std::string::npos)
-			msg.resize(stack);
-		std::string joined;
-		std::istringstream lines(msg);
-		for (std::string l; std::getline(lines, l);)
-		{
-			l = trim(l);
-			if (l.empty() || l.find("exception ====") != std::string::npos) continue;
-			joined += (joined.empty() ? "" : "; ") + l;
-		}
-		if (joined.find(file) != std::string::npos) throw std::runtime_error(joined);
-		throw std::runtime_error(file + ": " + joined);
+		const std::string msg = oneLineMessage(e.what());
+		const std::string named = msg.find(file) != std::string::npos ? msg : file + ": " + msg;
+		// Keep the kind: callers and tests tell invalid values from I/O errors.
+		if (dynamic_cast<const std::invalid_argument*>(&e)) throw std::invalid_argument(named);
+		throw std::runtime_error(named);
 	}
 }
 

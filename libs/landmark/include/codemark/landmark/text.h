@@ -51,8 +51,13 @@ void requireIniNumbers(
  * "FILE: " when the key is not found there. */
 std::string iniWhere(const std::string& file, const std::string& section, const std::string& key);
 
+/** An exception message on one line: MRPT's banner, "Location:" line and
+ * call stack dropped, the remaining lines joined with "; ". */
+std::string oneLineMessage(const std::string& what);
+
 /** Call inside a catch block around the loading of the ini \a file:
- * rethrows the exception being handled as std::runtime_error naming the
+ * rethrows the exception being handled as std::runtime_error (or
+ * std::invalid_argument if it was one) naming the
  * file, and the line for an IniValueError; one line (MRPT's banner and call
  * stack dropped). */
 [[noreturn]] void rethrowNamingIniFile(const std::string& file);
