@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
@@ -28,7 +29,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 		return 0;
 	try
 	{
-		const auto cam = codemark::CameraModel::load(path);
+		std::vector<std::string> warnings;  // collected, not printed
+		const auto cam = codemark::CameraModel::load(path, &warnings);
 		if (cam.width() <= 0 || cam.height() <= 0) __builtin_trap();
 		if (!std::isfinite(cam.params().fx()) || cam.params().fx() <= 0) __builtin_trap();
 	}

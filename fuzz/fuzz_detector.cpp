@@ -37,7 +37,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 		const uint8_t* px = data + 5;
 		const size_t n = size - 5;
 		const size_t bytes = image.total() * image.elemSize();
-		if (n == 0)
+		if (bytes == 0)
+		{
+			// an empty image (0 rows or columns): no pixel data
+		}
+		else if (n == 0)
 			std::memset(image.data, 0, bytes);
 		else
 			for (size_t i = 0; i < bytes; ++i) image.data[i] = px[i % n];

@@ -78,9 +78,33 @@ mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 		throw std::runtime_error(path + ": cannot parse OpenCV YAML: " + e.err);
 	}
 	if (!fs.isOpened()) throw std::runtime_error(path + ": cannot parse OpenCV YAML");
+	// OpenCV allocates rows x cols as the file says before reading the data
+	// (a damaged 'rows' asked it for 48 GB in fuzzing): check the sizes first.
+	auto dims = [&](const char* key, int max_total) {
+		const cv::FileNode n = fs[key];
+		if (n.empty() || n.isNone()) return 0;
+		if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt())
+			throw std::runtime_error(path + ": '" + key + "' is not an !!opencv-matrix");
+		const int r = static_cast<int>(n["rows"]), c = static_cast<int>(n["cols"]);
+		if (r < 1 || c < 1 || r > max_total || c > max_total || r * c > max_total)
+			throw std::runtime_error(
+				path + ": '" + key + "' has " + std::to_string(r) + "x" + std::to_string(c) +
+				" entries");
+		return r * c;
+	};
+	if (dims("camera_matrix", 9) != 9)
+		throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
+	dims("distortion_coefficients", 8);
 	cv::Mat K, D;
-	fs["camera_matrix"] >> K;
-	fs["distortion_coefficients"] >> D;
+	try
+	{
+		fs["camera_matrix"] >> K;
+		fs["distortion_coefficients"] >> D;
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(path + ": bad OpenCV YAML matrix: " + e.err);
+	}
 	int w = 0, h = 0;
 	fs["image_width"] >> w;
 	fs["image_height"] >> h;
@@ -179,8 +203,33 @@ void requireYamlNumbers(const mrpt::containers::yaml& node, const std::string& w
 			throw std::runtime_error(path + ": '" + what + "' holds '" + v + "', not a finite number");
 }
 
+/** Refuses what no camera YAML holds but makes libfyaml (0.8, Debian
+ * bookworm, inside MRPT's YAML reader) loop forever, found by fuzzing: a
+ * '%' directive line with non-ASCII bytes. Camera files are plain ASCII
+ * text without directives; say so instead of hanging. */
+void requirePlainYamlText(const std::string& path)
+{
+	std::ifstream in(path, std::ios::binary);
+	int line = 0;
+	for (std::string l; std::getline(in, l);)
+	{
+		++line;
+		if (!l.empty() && l[0] == '%')
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) + ": YAML directives ('%...') are not supported here");
+		for (const char ch : l)
+		{
+			const auto u = static_cast<unsigned char>(ch);
+			if ((u < 0x20 && u != '\t' && u != '\r') || u == 0x7f)
+				throw std::runtime_error(
+					path + ":" + std::to_string(line) + ": control character in a YAML text file");
+		}
+	}
+}
+
 mrpt::img::TCamera loadRosYaml(const std::string& path)
 {
+	requirePlainYamlText(path);
 	mrpt::containers::yaml y;
 	std::string diagnostics;
 	try
