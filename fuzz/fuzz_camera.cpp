@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 		return 0;
 	try
 	{
-		std::vector<std::string> warnings;  // collected, not printed
+		std::vector<std::string> warnings;	// collected, not printed
 		const auto cam = codemark::CameraModel::load(path, &warnings);
 		if (cam.width() <= 0 || cam.height() <= 0) __builtin_trap();
 		if (!std::isfinite(cam.params().fx()) || cam.params().fx() <= 0) __builtin_trap();

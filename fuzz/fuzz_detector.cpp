@@ -31,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 		if (size < 5) return 0;
 		const int w = (data[0] | (data[1] << 8)) & 1023;
 		const int h = (data[2] | (data[3] << 8)) & 1023;
-		static const int kTypes[] = {CV_8UC3, CV_8UC1, CV_8UC4, CV_16UC3, CV_16UC1, CV_8UC3, CV_8UC3, CV_8UC3};
+		static const int kTypes[] = {CV_8UC3,  CV_8UC1, CV_8UC4, CV_16UC3,
+									 CV_16UC1, CV_8UC3, CV_8UC3, CV_8UC3};
 		const int type = kTypes[data[4] & 7];
 		image.create(h, w, type);
 		const uint8_t* px = data + 5;

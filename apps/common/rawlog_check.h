@@ -27,7 +27,7 @@ inline void checkRawlogGzip(const std::string& path)
 		if (n < 2 || magic[0] != 0x1f || magic[1] != 0x8b) return;
 	}
 	else
-		return;  // the reader reports missing files itself
+		return;	 // the reader reports missing files itself
 	gzFile gz = gzopen(path.c_str(), "rb");
 	if (!gz) return;
 	static char buf[1 << 16];
@@ -40,7 +40,7 @@ inline void checkRawlogGzip(const std::string& path)
 	gzclose(gz);
 	if (n < 0 || (err != Z_OK && err != Z_STREAM_END))
 		throw std::runtime_error(
-			path + ": corrupt gzip data after " + std::to_string(total) +
-			" decompressed bytes (" + what + "); the rawlog is damaged");
+			path + ": corrupt gzip data after " + std::to_string(total) + " decompressed bytes (" +
+			what + "); the rawlog is damaged");
 }
 }  // namespace codemark::app

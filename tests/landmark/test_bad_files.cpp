@@ -46,23 +46,26 @@ TEST(BadFiles, IniNumbersNameFileLineAndKey)
 	const auto p = writeTemp("lm.ini", "# c\n[LANDMARK]\nouter_size_m = 0.2x\n");
 	mrpt::config::CConfigFile cfg(p);
 	LandmarkGeometry g;
-	const std::string e = errorOf([&] {
-		try
+	const std::string e = errorOf(
+		[&]
 		{
-			g.loadFromConfigFile(cfg, "LANDMARK");
-		}
-		catch (const std::exception&)
-		{
-			rethrowNamingIniFile(p);
-		}
-	});
+			try
+			{
+				g.loadFromConfigFile(cfg, "LANDMARK");
+			}
+			catch (const std::exception&)
+			{
+				rethrowNamingIniFile(p);
+			}
+		});
 	EXPECT_NE(e.find(p + ":3: [LANDMARK] outer_size_m = '0.2x'"), std::string::npos) << e;
 	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
 TEST(BadFiles, IniNumbersAcceptGoodValuesAndTrailingComments)
 {
-	const auto p = writeTemp("ok.ini", "[s]\na = 1.5 ; MRPT keeps this comment\nv = [1, 2 3]\nn = 7\n");
+	const auto p =
+		writeTemp("ok.ini", "[s]\na = 1.5 ; MRPT keeps this comment\nv = [1, 2 3]\nn = 7\n");
 	mrpt::config::CConfigFile cfg(p);
 	EXPECT_NO_THROW(requireIniNumbers(cfg, "s", {"a", "missing"}));
 	EXPECT_NO_THROW(requireIniNumbers(cfg, "s", {"v"}, false, true));
@@ -75,14 +78,19 @@ TEST(BadFiles, CameraIniBadNumberMissingKeyNan)
 {
 	const std::string good = kCamera;
 	EXPECT_NO_THROW(CameraModel::load(writeTemp("good.ini", good)));
-	const auto bad = writeTemp("bad.ini", std::string(kCamera).replace(good.find("fx = 800"), 8, "fx = 8o0"));
-	EXPECT_NE(errorOf([&] { CameraModel::load(bad); }).find(bad + ":5: [CAMERA_PARAMS] fx = '8o0'"),
+	const auto bad =
+		writeTemp("bad.ini", std::string(kCamera).replace(good.find("fx = 800"), 8, "fx = 8o0"));
+	EXPECT_NE(
+		errorOf([&] { CameraModel::load(bad); }).find(bad + ":5: [CAMERA_PARAMS] fx = '8o0'"),
 		std::string::npos);
-	const auto nan = writeTemp("nan.ini", std::string(kCamera).replace(good.find("fy = 800"), 8, "fy = nan"));
+	const auto nan =
+		writeTemp("nan.ini", std::string(kCamera).replace(good.find("fy = 800"), 8, "fy = nan"));
 	EXPECT_NE(errorOf([&] { CameraModel::load(nan); }).find(nan + ":6:"), std::string::npos);
-	const auto res = writeTemp("res.ini", std::string(kCamera).replace(good.find("[640 480]"), 9, "[640 x]"));
+	const auto res =
+		writeTemp("res.ini", std::string(kCamera).replace(good.find("[640 480]"), 9, "[640 x]"));
 	EXPECT_NE(errorOf([&] { CameraModel::load(res); }).find("resolution"), std::string::npos);
-	const auto missing = writeTemp("missing.ini", std::string(kCamera).replace(good.find("fx = 800\n"), 9, ""));
+	const auto missing =
+		writeTemp("missing.ini", std::string(kCamera).replace(good.find("fx = 800\n"), 9, ""));
 	EXPECT_NE(errorOf([&] { CameraModel::load(missing); }).find("'fx'"), std::string::npos);
 }
 
@@ -93,9 +101,11 @@ TEST(BadFiles, RosYamlBadNumberAndSyntaxError)
 		"  data: [800, 0, 319.5, 0, 800, 239.5, 0, 0, 1]\ndistortion_model: plumb_bob\n"
 		"distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
 	EXPECT_NO_THROW(CameraModel::load(writeTemp("good.yaml", ros)));
-	const auto bad = writeTemp("bad.yaml", std::string(ros).replace(ros.find("800, 0, 319.5"), 3, "8x0"));
+	const auto bad =
+		writeTemp("bad.yaml", std::string(ros).replace(ros.find("800, 0, 319.5"), 3, "8x0"));
 	EXPECT_NE(errorOf([&] { CameraModel::load(bad); }).find("'8x0'"), std::string::npos);
-	const auto shortm = writeTemp("short.yaml", std::string(ros).replace(ros.find(", 0, 0, 1]"), 10, "]"));
+	const auto shortm =
+		writeTemp("short.yaml", std::string(ros).replace(ros.find(", 0, 0, 1]"), 10, "]"));
 	EXPECT_NE(errorOf([&] { CameraModel::load(shortm); }).find("9 numbers"), std::string::npos);
 	// A syntax error: libfyaml's diagnostic becomes the one-line message, with the line.
 	const auto garbage = writeTemp("garbage.yaml", "image_width: [640\n: : :\n");

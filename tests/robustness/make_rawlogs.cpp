@@ -75,7 +75,8 @@ int badOdometry(const std::string& in, const std::string& out, double bad)
 			if (!mv || ++seen != 2) continue;
 			CActionRobotMovement2D nan;
 			nan.timestamp = mv->timestamp;
-			nan.computeFromOdometry(mrpt::poses::CPose2D(bad, 0, bad), mv->motionModelConfiguration);
+			nan.computeFromOdometry(
+				mrpt::poses::CPose2D(bad, 0, bad), mv->motionModelConfiguration);
 			acts->clear();
 			acts->insert(nan);
 		}
@@ -126,7 +127,8 @@ int scans(const std::string& out)
 		s->sensorLabel = "LASER";
 		s->timestamp = mrpt::Clock::fromDouble(1.0e9 + i);
 		s->resizeScan(10);
-		for (size_t k = 0; k < 10; ++k) s->setScanRange(k, 1.0f + k), s->setScanRangeValidity(k, true);
+		for (size_t k = 0; k < 10; ++k)
+			s->setScanRange(k, 1.0f + k), s->setScanRangeValidity(k, true);
 		objs.push_back(s);
 	}
 	writeAll(out, objs);
