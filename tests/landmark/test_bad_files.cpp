@@ -113,3 +113,15 @@ TEST(BadFiles, RosYamlBadNumberAndSyntaxError)
 	EXPECT_NE(e.find(garbage + ":2:"), std::string::npos) << e;
 	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
+
+TEST(BadFiles, YamlDirectivesAndControlCharactersAreRefused)
+{
+	// libfyaml 0.8 loops forever on some directives (found by fuzz_camera),
+	// also after a lone '\r' line break; camera files never hold any.
+	const auto directive = writeTemp("directive.yaml", "image_width: 320\nx: 1 \r\r%ta: [8\n");
+	const std::string e = errorOf([&] { CameraModel::load(directive); });
+	EXPECT_NE(e.find(directive + ":4: YAML directives"), std::string::npos) << e;
+	const auto control = writeTemp("control.yaml", std::string("image_width: 3\x01\n", 16));
+	EXPECT_NE(
+		errorOf([&] { CameraModel::load(control); }).find("control character"), std::string::npos);
+}

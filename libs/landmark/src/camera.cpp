@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -210,20 +211,26 @@ void requireYamlNumbers(const mrpt::containers::yaml& node, const std::string& w
 void requirePlainYamlText(const std::string& path)
 {
 	std::ifstream in(path, std::ios::binary);
-	int line = 0;
-	for (std::string l; std::getline(in, l);)
+	const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+	int line = 1;
+	bool line_start = true;  // YAML breaks lines at '\n', '\r' and "\r\n"
+	for (std::size_t i = 0; i < text.size(); ++i)
 	{
-		++line;
-		if (!l.empty() && l[0] == '%')
-			throw std::runtime_error(
-				path + ":" + std::to_string(line) + ": YAML directives ('%...') are not supported here");
-		for (const char ch : l)
+		const auto u = static_cast<unsigned char>(text[i]);
+		if (u == '\n' || u == '\r')
 		{
-			const auto u = static_cast<unsigned char>(ch);
-			if ((u < 0x20 && u != '\t' && u != '\r') || u == 0x7f)
-				throw std::runtime_error(
-					path + ":" + std::to_string(line) + ": control character in a YAML text file");
+			if (!(u == '\n' && i > 0 && text[i - 1] == '\r')) ++line;
+			line_start = true;
+			continue;
 		}
+		if (line_start && u == '%')
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) +
+				": YAML directives ('%...') are not supported here");
+		if ((u < 0x20 && u != '\t') || u == 0x7f)
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) + ": control character in a YAML text file");
+		line_start = false;
 	}
 }
 
