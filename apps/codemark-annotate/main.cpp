@@ -1,5 +1,6 @@
 // codemark-annotate: adds a codemark landmark observation after every camera
 // image of an MRPT rawlog.
+#include <codemark/landmark/text.h>
 #include <codemark/pipeline/annotate.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
@@ -9,7 +10,9 @@
 #include <iomanip>
 #include <iostream>
 
+#include "errors.h"
 #include "progress.h"
+#include "rawlog_check.h"
 
 int main(int argc, char** argv)
 {
@@ -56,23 +59,53 @@ int main(int argc, char** argv)
 		if (!lm.empty())
 		{
 			if (!std::ifstream(lm).good()) throw std::runtime_error(lm + ": cannot open");
-			mrpt::config::CConfigFile cfg(lm);
-			o.pipeline.geometry.loadFromConfigFile(cfg, "LANDMARK");
+			try
+			{
+				mrpt::config::CConfigFile cfg(lm);
+				o.pipeline.geometry.loadFromConfigFile(cfg, "LANDMARK");
+			}
+			catch (const std::exception&)
+			{
+				codemark::rethrowNamingIniFile(lm);
+			}
 		}
 		if (!map.getValue().empty()) o.pipeline.map = codemark::LandmarkMap::load(map.getValue());
 		if (!config.getValue().empty())
 		{
 			if (!std::ifstream(config.getValue()).good())
 				throw std::runtime_error(config.getValue() + ": cannot open");
-			mrpt::config::CConfigFile cfg(config.getValue());
-			o.pipeline.detector.loadFromConfigFile(cfg, "DETECTOR");
-			o.pipeline.pose.loadFromConfigFile(cfg, "pose");
+			try
+			{
+				mrpt::config::CConfigFile cfg(config.getValue());
+				o.pipeline.detector.loadFromConfigFile(cfg, "DETECTOR");
+				o.pipeline.pose.loadFromConfigFile(cfg, "pose");
+			}
+			catch (const std::exception&)
+			{
+				codemark::rethrowNamingIniFile(config.getValue());
+			}
 		}
 
+		codemark::app::checkRawlogGzip(in.getValue());
 		codemark::app::ProgressBar bar("codemark-annotate", !quiet.getValue());
-		const auto s = codemark::pipeline::annotateRawlog(
-			in.getValue(), out.getValue(), o, [&](long d, long t) { bar.update(d, t); });
+		codemark::pipeline::AnnotateSummary s;
+		try
+		{
+			s = codemark::pipeline::annotateRawlog(
+				in.getValue(), out.getValue(), o, [&](long d, long t) { bar.update(d, t); });
+		}
+		catch (const std::exception& e)
+		{
+			// Errors about an image (decoder, missing file) may not name the rawlog.
+			const std::string msg = codemark::app::oneLine(mrpt::exception_to_str(e));
+			throw std::runtime_error(
+				msg.find(in.getValue()) == std::string::npos ? in.getValue() + ": " + msg : msg);
+		}
 		bar.finish();
+		if (s.images == 0)
+			throw std::runtime_error(
+				in.getValue() + ": no camera image (CObservationImage) in its " +
+				std::to_string(s.entries) + " entries; nothing to annotate");
 		std::cout << "codemark-annotate: " << s.entries << " entries ("
 				  << (s.actions_observations ? "actions-observations" : "observations-only")
 				  << " format), " << s.images << " images, " << s.detections
@@ -90,7 +123,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-annotate: error: " << mrpt::exception_to_str(e) << "\n";
+		std::cerr << "codemark-annotate: error: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
 	}
 	return 1;
 }

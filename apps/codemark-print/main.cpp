@@ -9,6 +9,8 @@
 #include <exception>
 #include <iostream>
 
+#include "errors.h"
+
 int main(int argc, char** argv)
 {
 	namespace cp = codemark::print;
@@ -97,7 +99,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-print: error: " << e.what() << "\n";
+		std::cerr << "codemark-print: error: " << codemark::app::oneLine(e.what()) << "\n";
 		return 1;
 	}
 }

@@ -1,5 +1,6 @@
 // codemark-render: renders camera frames of a landmark map with exact ground
 // truth (the demo's render step). A thin main over codemark::sim.
+#include <codemark/landmark/text.h>
 #include <codemark/sim/frames.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
@@ -13,6 +14,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "errors.h"
 #include "progress.h"
 
 namespace
@@ -28,28 +30,13 @@ codemark::sim::RenderOptions demoOptions()
 	return o;
 }
 
-/** One line out of an exception message: MRPT's exceptions carry a banner
- * and a call stack that say nothing to a user. */
-std::string oneLine(const std::string& what)
-{
-	std::string msg = what;
-	const auto stack = msg.find("Call stack backtrace");
-	if (stack != std::string::npos) msg.resize(stack);
-	std::string out, line;
-	std::istringstream in(msg);
-	while (std::getline(in, line))
-	{
-		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos) continue;
-		out += (out.empty() ? "" : "; ") + line;
-	}
-	return out.empty() ? what : out;
-}
 }  // namespace
 
 int main(int argc, char** argv)
 {
 	namespace fs = std::filesystem;
 	using namespace codemark;
+	using app::oneLine;
 	try
 	{
 		TCLAP::CmdLine cmd(
@@ -127,9 +114,9 @@ int main(int argc, char** argv)
 			{
 				options.loadFromConfigFile(cfg, sectionArg.getValue());
 			}
-			catch (const std::exception& e)
+			catch (const std::exception&)
 			{
-				throw std::runtime_error(optionsArg.getValue() + " [" + sectionArg.getValue() + "]: " + e.what());
+				rethrowNamingIniFile(optionsArg.getValue());
 			}
 		}
 

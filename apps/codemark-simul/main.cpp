@@ -1,5 +1,6 @@
 // codemark-simul: writes a simulated MRPT dataset (rawlog with external
 // images, map, ground truth) from an ini file.
+#include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
@@ -8,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "errors.h"
 #include "progress.h"
 
 int main(int argc, char** argv)
@@ -42,7 +44,14 @@ int main(int argc, char** argv)
 			if (!std::ifstream(config.getValue()).good())
 				throw std::runtime_error(config.getValue() + ": cannot open config file");
 			mrpt::config::CConfigFile cfg(config.getValue());
-			opts.loadFromConfigFile(cfg, "");
+			try
+			{
+				opts.loadFromConfigFile(cfg, "");
+			}
+			catch (const std::exception&)
+			{
+				codemark::rethrowNamingIniFile(config.getValue());
+			}
 		}
 		if (seed.isSet()) opts.seed = seed.getValue();
 		codemark::app::ProgressBar bar("codemark-simul", !quiet.getValue());
@@ -62,7 +71,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-simul: " << mrpt::exception_to_str(e) << "\n";
+		std::cerr << "codemark-simul: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
 	}
 	return 1;
 }

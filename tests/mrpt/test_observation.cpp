@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <random>
 
 using codemark::CObservationCodedLandmarks;
@@ -216,4 +217,19 @@ TEST(CodedLandmarksObs, DescriptionIsReadable)
 	EXPECT_NE(t.find("range l2"), std::string::npos);
 	EXPECT_NE(t.find("deg"), std::string::npos);
 	EXPECT_NE(t.find("corners"), std::string::npos);
+}
+
+TEST(CodedLandmarksObs, NonFiniteMeasurementIsCorruptData)
+{
+	// Written as is (serializeTo does not judge), refused on reading.
+	for (int field = 0; field < 3; ++field)
+	{
+		auto o = makeFilled();
+		ASSERT_FALSE(o.sightings.empty());
+		auto& s = o.sightings.back();
+		if (field == 0) s.L.x() = std::numeric_limits<double>::quiet_NaN();
+		if (field == 1) s.P(2) = std::numeric_limits<double>::infinity();
+		if (field == 2) s.C_L(1, 1) = -std::numeric_limits<double>::infinity();
+		EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o))) << "field " << field;
+	}
 }

@@ -1,16 +1,21 @@
 #include <codemark/landmark/camera.h>
+#include <codemark/landmark/text.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/containers/yaml.h>
 
 #include <Eigen/Dense>
+#include <opencv2/core.hpp>
 #include <opencv2/core/persistence.hpp>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,11 +69,43 @@ bool startsWithOpenCvYaml(const std::string& path)
 
 mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 {
-	cv::FileStorage fs(path, cv::FileStorage::READ);
+	cv::FileStorage fs;
+	try
+	{
+		fs.open(path, cv::FileStorage::READ);
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(path + ": cannot parse OpenCV YAML: " + e.err);
+	}
 	if (!fs.isOpened()) throw std::runtime_error(path + ": cannot parse OpenCV YAML");
+	// OpenCV allocates rows x cols as the file says before reading the data
+	// (a damaged 'rows' asked it for 48 GB in fuzzing): check the sizes first.
+	auto dims = [&](const char* key, int max_total) {
+		const cv::FileNode n = fs[key];
+		if (n.empty() || n.isNone()) return 0;
+		if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt())
+			throw std::runtime_error(path + ": '" + key + "' is not an !!opencv-matrix");
+		const int r = static_cast<int>(n["rows"]), c = static_cast<int>(n["cols"]);
+		if (r < 1 || c < 1 || r > max_total || c > max_total || r * c > max_total)
+			throw std::runtime_error(
+				path + ": '" + key + "' has " + std::to_string(r) + "x" + std::to_string(c) +
+				" entries");
+		return r * c;
+	};
+	if (dims("camera_matrix", 9) != 9)
+		throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
+	dims("distortion_coefficients", 8);
 	cv::Mat K, D;
-	fs["camera_matrix"] >> K;
-	fs["distortion_coefficients"] >> D;
+	try
+	{
+		fs["camera_matrix"] >> K;
+		fs["distortion_coefficients"] >> D;
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(path + ": bad OpenCV YAML matrix: " + e.err);
+	}
 	int w = 0, h = 0;
 	fs["image_width"] >> w;
 	fs["image_height"] >> h;
@@ -96,20 +133,143 @@ mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 	return c;
 }
 
-mrpt::img::TCamera loadRosYaml(const std::string& path)
+/** Runs \a f with the process' stderr (file descriptor 2) sent to a
+ * temporary file and returns what was written there. MRPT's YAML parser
+ * (libfyaml inside mrpt::containers::yaml) prints its syntax errors to
+ * stderr and then returns a partial document; we want them in the error
+ * message instead, as one line naming the file and line. */
+template <typename F>
+std::string capturingStderr(F&& f)
 {
-	mrpt::containers::yaml y;
+	std::fflush(stderr);
+	std::FILE* tmp = std::tmpfile();
+	const int saved = tmp ? dup(2) : -1;
+	if (saved < 0)
+	{
+		if (tmp) std::fclose(tmp);
+		f();
+		return {};
+	}
+	dup2(fileno(tmp), 2);
+	std::string captured;
+	auto restore = [&]() {
+		std::fflush(stderr);
+		dup2(saved, 2);
+		close(saved);
+		std::rewind(tmp);
+		char buf[512];
+		for (size_t n; (n = std::fread(buf, 1, sizeof(buf), tmp)) > 0;) captured.append(buf, n);
+		std::fclose(tmp);
+	};
 	try
 	{
-		y = mrpt::containers::yaml::FromFile(path);
+		f();
+	}
+	catch (...)
+	{
+		restore();
+		throw;
+	}
+	restore();
+	return captured;
+}
+
+/** Every scalar of a YAML number field as text is a finite number. */
+void requireYamlNumbers(const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
+{
+	std::vector<std::string> values;
+	auto text = [&](const auto& scalar) {
+		try
+		{
+			values.push_back(scalar.template as<std::string>());
+		}
+		catch (const std::exception&)
+		{
+			// Not stored as text (cannot happen for a parsed file): MRPT checks it.
+		}
+	};
+	if (node.isSequence())
+		for (const auto& v : node.asSequence())
+		{
+			if (!v.isScalar())
+				throw std::runtime_error(path + ": '" + what + "' must be a list of numbers");
+			text(v);
+		}
+	else if (node.isScalar())
+		text(node);
+	else
+		throw std::runtime_error(path + ": '" + what + "' must be a number or a list of numbers");
+	for (const auto& v : values)
+		if (!parseFiniteNumber(v))
+			throw std::runtime_error(path + ": '" + what + "' holds '" + v + "', not a finite number");
+}
+
+/** Refuses what no camera YAML holds but makes libfyaml (0.8, Debian
+ * bookworm, inside MRPT's YAML reader) loop forever, found by fuzzing: a
+ * '%' directive line with non-ASCII bytes. Camera files are plain ASCII
+ * text without directives; say so instead of hanging. */
+void requirePlainYamlText(const std::string& path)
+{
+	std::ifstream in(path, std::ios::binary);
+	const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+	int line = 1;
+	bool line_start = true;  // YAML breaks lines at '\n', '\r' and "\r\n"
+	for (std::size_t i = 0; i < text.size(); ++i)
+	{
+		const auto u = static_cast<unsigned char>(text[i]);
+		if (u == '\n' || u == '\r')
+		{
+			if (!(u == '\n' && i > 0 && text[i - 1] == '\r')) ++line;
+			line_start = true;
+			continue;
+		}
+		if (line_start && u == '%')
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) +
+				": YAML directives ('%...') are not supported here");
+		if ((u < 0x20 && u != '\t') || u == 0x7f)
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) + ": control character in a YAML text file");
+		line_start = false;
+	}
+}
+
+mrpt::img::TCamera loadRosYaml(const std::string& path)
+{
+	requirePlainYamlText(path);
+	mrpt::containers::yaml y;
+	std::string diagnostics;
+	try
+	{
+		diagnostics = capturingStderr([&]() { y = mrpt::containers::yaml::FromFile(path); });
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + ": cannot parse YAML: " + e.what());
+		throw std::runtime_error(path + ": cannot parse YAML: " + oneLineMessage(e.what()));
+	}
+	// libfyaml's "<memory-@0x...>:LINE:COL: error: MESSAGE" -> "PATH:LINE:COL: error: MESSAGE".
+	if (const auto err = diagnostics.find(": error: "); err != std::string::npos)
+	{
+		const auto begin = diagnostics.rfind('\n', err);
+		std::string line = diagnostics.substr(begin == std::string::npos ? 0 : begin + 1);
+		line = line.substr(0, line.find('\n'));
+		const auto close = line.find(">:");
+		throw std::runtime_error(
+			path + ":" + (close == std::string::npos ? " " + line : line.substr(close + 2)));
 	}
 	for (const char* key : {"image_width", "image_height", "camera_matrix"})
 		if (!y.has(key))
 			throw std::runtime_error(path + ": missing required key '" + std::string(key) + "'");
+	requireYamlNumbers(y["image_width"], "image_width", path);
+	requireYamlNumbers(y["image_height"], "image_height", path);
+	if (!y["camera_matrix"].isMap() || !y["camera_matrix"].has("data"))
+		throw std::runtime_error(path + ": 'camera_matrix' needs 'data: [9 numbers]'");
+	requireYamlNumbers(y["camera_matrix"]["data"], "camera_matrix.data", path);
+	if (y["camera_matrix"]["data"].asSequence().size() != 9)
+		throw std::runtime_error(path + ": 'camera_matrix.data' must hold 9 numbers");
+	if (y.has("distortion_coefficients") && y["distortion_coefficients"].isMap() &&
+		y["distortion_coefficients"].has("data"))
+		requireYamlNumbers(y["distortion_coefficients"]["data"], "distortion_coefficients.data", path);
 	if (!y.has("camera_name")) y["camera_name"] = std::string("camera");
 	if (!y.has("distortion_coefficients"))
 	{
@@ -121,7 +281,7 @@ mrpt::img::TCamera loadRosYaml(const std::string& path)
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + ": bad camera YAML: " + e.what());
+		throw std::runtime_error(path + ": bad camera YAML: " + oneLineMessage(e.what()));
 	}
 }
 
@@ -146,6 +306,14 @@ mrpt::img::TCamera loadIni(
 				"MRPT ignores the distortion in that case, and so does codemark. "
 				"Add 'distortion_model = plumb_bob' to use it.");
 	}
+	// MRPT reads "8o0" as 8 and "abc" as 0: check the numbers first.
+	requireIniNumbers(cfg, section, {"cx", "cy", "fx", "fy", "focal_length"}, false, false, path);
+	requireIniNumbers(cfg, section, {"resolution"}, true, true, path);
+	requireIniNumbers(cfg, section, {"dist"}, false, true, path);
+	for (const char* key : {"resolution", "cx", "cy", "fx", "fy"})
+		if (!cfg.keyExists(section, key))
+			throw std::runtime_error(
+				path + ": [" + section + "] misses the required key '" + key + "'");
 	mrpt::img::TCamera c;
 	try
 	{
@@ -154,7 +322,7 @@ mrpt::img::TCamera loadIni(
 	catch (const std::exception& e)
 	{
 		throw std::runtime_error(
-			path + ": [" + section + "]: " + mrpt::exception_to_str(e));
+			path + ": [" + section + "]: " + oneLineMessage(mrpt::exception_to_str(e)));
 	}
 	return c;
 }

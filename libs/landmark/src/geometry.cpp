@@ -1,4 +1,5 @@
 #include <codemark/landmark/geometry.h>
+#include <codemark/landmark/text.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <cmath>
@@ -59,6 +60,7 @@ void LandmarkGeometry::validate() const
 void LandmarkGeometry::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
+	requireIniNumbers(c, s, {"outer_size_m", "inner_size_m", "cell_size_m", "margin_m", "scale"});
 	MRPT_LOAD_CONFIG_VAR(outer_size_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(inner_size_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(cell_size_m, double, c, s);

@@ -1,6 +1,9 @@
 #include <codemark/landmark/text.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -37,6 +40,121 @@ std::vector<double> parseNumberRow(
 		v.push_back(*x);
 	}
 	return v;
+}
+
+namespace
+{
+std::string trim(const std::string& s)
+{
+	const auto b = s.find_first_not_of(" \t\r\n");
+	if (b == std::string::npos) return {};
+	const auto e = s.find_last_not_of(" \t\r\n");
+	return s.substr(b, e - b + 1);
+}
+
+bool sameName(const std::string& a, const std::string& b)
+{
+	return a.size() == b.size() &&
+		std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+			return std::tolower(static_cast<unsigned char>(x)) ==
+				std::tolower(static_cast<unsigned char>(y));
+		});
+}
+}  // namespace
+
+std::string iniWhere(const std::string& file, const std::string& section, const std::string& key)
+{
+	std::ifstream in(file);
+	std::string current;
+	int n = 0;
+	for (std::string line; std::getline(in, line);)
+	{
+		++n;
+		const std::string t = trim(line);
+		if (t.empty() || t[0] == '#' || t[0] == ';' || t.rfind("//", 0) == 0) continue;
+		if (t[0] == '[')
+		{
+			const auto close = t.find(']');
+			current = trim(t.substr(1, close == std::string::npos ? std::string::npos : close - 1));
+			continue;
+		}
+		const auto eq = t.find('=');
+		if (eq != std::string::npos && sameName(current, section) &&
+			sameName(trim(t.substr(0, eq)), key))
+			return file + ":" + std::to_string(n) + ": ";
+	}
+	return file + ": ";
+}
+
+std::string oneLineMessage(const std::string& what)
+{
+	std::string msg = what;
+	if (const auto stack = msg.find("Call stack backtrace"); stack != std::string::npos)
+		msg.resize(stack);
+	std::string joined;
+	std::istringstream lines(msg);
+	for (std::string l; std::getline(lines, l);)
+	{
+		l = trim(l);
+		if (l.empty() || l.find("exception ====") != std::string::npos) continue;
+		if (l.rfind("Location:", 0) == 0) continue;
+		if (l.rfind("Message:", 0) == 0) l = trim(l.substr(8));
+		joined += (joined.empty() ? "" : "; ") + l;
+	}
+	return joined.empty() ? trim(what) : joined;
+}
+
+void rethrowNamingIniFile(const std::string& file)
+{
+	try
+	{
+		throw;
+	}
+	catch (const IniValueError& e)
+	{
+		const std::string what = e.what();
+		if (what.find(file) != std::string::npos) throw std::runtime_error(what);
+		throw std::runtime_error(iniWhere(file, e.section, e.key) + what);
+	}
+	catch (const std::exception& e)
+	{
+		const std::string msg = oneLineMessage(e.what());
+		const std::string named = msg.find(file) != std::string::npos ? msg : file + ": " + msg;
+		// Keep the kind: callers and tests tell invalid values from I/O errors.
+		if (dynamic_cast<const std::invalid_argument*>(&e)) throw std::invalid_argument(named);
+		throw std::runtime_error(named);
+	}
+}
+
+void requireIniNumbers(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+	std::initializer_list<const char*> keys, bool integers, bool vector, const std::string& file)
+{
+	for (const char* key : keys)
+	{
+		if (!cfg.keyExists(section, key)) continue;
+		const std::string raw = cfg.read_string(section, key, "");
+		std::string v = raw;
+		if (const auto c = v.find_first_of(";#"); c != std::string::npos) v.erase(c);
+		v = trim(v);
+		if (vector && v.size() >= 2 && v.front() == '[' && v.back() == ']') v = v.substr(1, v.size() - 2);
+		std::replace(v.begin(), v.end(), ',', ' ');
+		std::istringstream ss(v);
+		int count = 0;
+		bool ok = true;
+		for (std::string tok; ss >> tok && ok; ++count)
+		{
+			const auto x = parseFiniteNumber(tok);
+			ok = x && (!integers || std::floor(*x) == *x);
+		}
+		if (ok && (count == 1 || (vector && count > 0))) continue;
+		throw IniValueError(
+			section, key,
+			(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " +
+				key + " = '" + trim(raw) +
+			"': not " + (vector ? "a list of " : "a ") + (integers ? "whole" : "finite") +
+			(vector ? " numbers" : " number"));
+	}
 }
 
 }  // namespace codemark

@@ -104,6 +104,16 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 						"CObservationCodedLandmarks: corrupt data, pose method %u",
 						static_cast<unsigned>(m));
 				s.method = static_cast<pose::PoseMethod>(m);
+				// A detection never has a non-finite measurement; such a value
+				// would only poison a filter later, far from its cause.
+				bool finite = s.P.allFinite() && s.L.allFinite() && s.C_L.allFinite() &&
+					s.pose_in_landmark.allFinite();
+				for (const auto& c : s.corners) finite = finite && c.allFinite();
+				if (!finite)
+					THROW_EXCEPTION_FMT(
+						"CObservationCodedLandmarks: corrupt data, non-finite measurement of "
+						"landmark %d",
+						s.id);
 			}
 		}
 		break;

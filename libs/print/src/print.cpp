@@ -1,3 +1,4 @@
+#include <codemark/landmark/text.h>
 #include <codemark/print/output.h>
 #include <codemark/print/page.h>
 #include <codemark/print/print.h>
@@ -140,13 +141,9 @@ LandmarkGeometry geometryOf(const PrintOptions& o)
 				throw std::invalid_argument("it has no [LANDMARK] section");
 			g.loadFromConfigFile(cfg, "LANDMARK");
 		}
-		catch (const std::exception& e)
+		catch (const std::exception&)
 		{
-			// MRPT's messages span several lines; keep the first.
-			std::string msg = e.what();
-			const auto nl = msg.find('\n');
-			if (nl != std::string::npos) msg.resize(nl);
-			throw std::invalid_argument("landmark file '" + path + "': " + msg);
+			rethrowNamingIniFile(path);  // one line, with the line of a bad number
 		}
 	}
 	g.outer_size_m *= o.scale;

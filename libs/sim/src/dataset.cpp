@@ -50,6 +50,20 @@ void require(bool ok, const std::string& what)
 
 void DatasetOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string&)
 {
+	// MRPT's readers take "six" as 0 and "0.5m" as 0.5: check the numbers first.
+	requireIniNumbers(c, "map", {"room_width_m", "room_depth_m", "landmark_height_m"});
+	requireIniNumbers(c, "map", {"room_landmarks", "first_id"}, true);
+	requireIniNumbers(c, "trajectory", {"loop_margin_m", "corner_radius_m", "speed_mps"});
+	requireIniNumbers(c, "trajectory", {"loops"}, true);
+	requireIniNumbers(c, "dataset", {"frame_rate_hz", "odometry_rate_hz", "start_time"});
+	requireIniNumbers(c, "dataset", {"seed"}, true);
+	requireIniNumbers(
+		c, "odometry",
+		{"gaussian_alpha_1", "gaussian_alpha_2", "gaussian_alpha_3", "gaussian_alpha_4",
+		 "gaussian_min_std_xy", "gaussian_min_std_phi_deg", "thrun_alfa1_rot_rot",
+		 "thrun_alfa2_rot_trans", "thrun_alfa3_trans_trans", "thrun_alfa4_trans_rot",
+		 "thrun_additional_std_xy", "thrun_additional_std_phi", "odometry_scale_error"});
+	requireIniNumbers(c, "camera", {"camera_x_m", "camera_y_m", "camera_z_m", "camera_yaw_deg"});
 	map_file = c.read_string("map", "map_file", map_file);
 	MRPT_LOAD_CONFIG_VAR(room_width_m, double, c, "map");
 	MRPT_LOAD_CONFIG_VAR(room_depth_m, double, c, "map");
@@ -351,6 +365,10 @@ DatasetSummary writeDataset(
 {
 	DatasetSummary sum;
 	sum.map = o.map_file.empty() ? generateRoomMap(o) : LandmarkMap::load(o.map_file);
+	if (sum.map.landmarks.empty())
+		throw std::runtime_error(
+			(o.map_file.empty() ? std::string("[map] room_landmarks = 0") : o.map_file) +
+			": the map has no landmarks");
 	const CameraModel camera =
 		o.camera_file.empty() ? CameraModel::paperDefault() : CameraModel::load(o.camera_file);
 	const CPose3D cam_on_robot = o.cameraPoseOnRobot();

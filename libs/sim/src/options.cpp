@@ -1,3 +1,4 @@
+#include <codemark/landmark/text.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -101,6 +102,12 @@ void RenderOptions::validate() const
 void RenderOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
+	// MRPT's readers take "abc" as 0 and "2px" as 2: check the numbers first.
+	requireIniNumbers(
+		c, s,
+		{"background_grey", "gain", "gradient", "gradient_angle_rad", "noise_sigma",
+		 "blur_sigma_px", "motion_blur_px", "motion_blur_angle_rad", "occlusion"});
+	requireIniNumbers(c, s, {"distractors", "jpeg_quality", "supersampling"}, true);
 	background = backgroundFromName(c.read_string(s, "background", backgroundName(background)));
 	MRPT_LOAD_CONFIG_VAR(background_grey, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(distractors, int, c, s);

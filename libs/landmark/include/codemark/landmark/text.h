@@ -3,6 +3,10 @@
  * Reading the project's plain-text tables (map files, trajectories, ground
  * truth, pose lists): strict numbers, and errors that name the file and line.
  */
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <initializer_list>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,5 +22,44 @@ std::optional<double> parseFiniteNumber(const std::string& token);
  * std::runtime_error "FILE:LINE: 'TOKEN' is not a finite number". */
 std::vector<double> parseNumberRow(
 	std::string text, const std::string& file, int line, const char* comment_chars = "#");
+
+/** A bad value in an ini file: the section and key at fault (the file is
+ * not known to MRPT's config readers; see rethrowNamingIniFile()). */
+class IniValueError : public std::runtime_error
+{
+   public:
+	IniValueError(const std::string& section_, const std::string& key_, const std::string& what)
+		: std::runtime_error(what), section(section_), key(key_)
+	{
+	}
+	std::string section, key;
+};
+
+/** Checks that each of \a keys that [\a section] of \a cfg sets holds
+ * finite numbers only (MRPT's read_double() takes "0.2x" as 0.2 and "abc"
+ * as 0): one number, or with \a vector a list such as "[640 480]". With
+ * \a integers the numbers must also be whole. A trailing ';' or '#' comment
+ * is allowed, as MRPT keeps those in values. Throws IniValueError
+ * "[SECTION] KEY = 'VALUE': not a finite number", prefixed with
+ * "FILE:LINE: " when \a file (the ini's path) is given. */
+void requireIniNumbers(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+	std::initializer_list<const char*> keys, bool integers = false, bool vector = false,
+	const std::string& file = {});
+
+/** "FILE:LINE: " of \a key in [\a section] of the ini file \a file, or
+ * "FILE: " when the key is not found there. */
+std::string iniWhere(const std::string& file, const std::string& section, const std::string& key);
+
+/** An exception message on one line: MRPT's banner, "Location:" line and
+ * call stack dropped, the remaining lines joined with "; ". */
+std::string oneLineMessage(const std::string& what);
+
+/** Call inside a catch block around the loading of the ini \a file:
+ * rethrows the exception being handled as std::runtime_error (or
+ * std::invalid_argument if it was one) naming the
+ * file, and the line for an IniValueError; one line (MRPT's banner and call
+ * stack dropped). */
+[[noreturn]] void rethrowNamingIniFile(const std::string& file);
 
 }  // namespace codemark

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Builds codemark's libFuzzer targets with clang-14 (build-fuzz/, CODEMARK_FUZZ=ON)
+# and runs each for SECONDS (default 60) from its seed corpus in
+# fuzz/corpus/<target>/. Fails on the first crash, leak, timeout or
+# out-of-memory; the reproducer is left in fuzz/crashes/<target>/.
+#   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 600 fuzz_map
+# Environment:
+# FUZZ_BUILD_DIR (default build-fuzz), FUZZ_NO_BUILD=1 to skip the build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_PER_TARGET=60
+if [[ $# -gt 0 && "$1" =~ ^[0-9]+$ ]]; then SECONDS_PER_TARGET=$1; shift; fi
+TARGETS=("$@")
+[[ ${#TARGETS[@]} -eq 0 ]] && TARGETS=(fuzz_detector fuzz_map fuzz_camera fuzz_deserialize)
+BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
+CXX_CLANG=$(command -v clang++-14 || command -v clang++)
+
+if [[ "${FUZZ_NO_BUILD:-0}" != 1 ]]; then
+  cmake -S . -B "$BUILD" -DCMAKE_CXX_COMPILER="$CXX_CLANG" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCODEMARK_FUZZ=ON -DCODEMARK_BUILD_BENCH=OFF -DCODEMARK_BUILD_TESTS=OFF >/dev/null
+  cmake --build "$BUILD" -j"$(nproc)" --target "${TARGETS[@]}"
+fi
+
+# OpenCV and MRPT are not instrumented; their one-time allocations are not leaks of ours.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0:abort_on_error=1:symbolize=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
+status=0
+for t in "${TARGETS[@]}"; do
+  corpus_seed=fuzz/corpus/$t
+  work=$BUILD/corpus/$t           # grows during the run; the committed seeds stay small
+  crashes=fuzz/crashes/$t
+  mkdir -p "$work" "$crashes"
+  echo "fuzz.sh: $t for ${SECONDS_PER_TARGET} s"
+  if ! "$BUILD/fuzz/$t" "$work" "$corpus_seed" -max_total_time="$SECONDS_PER_TARGET" \
+      -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+      -artifact_prefix="$crashes/" \
+      >"$BUILD/$t.log" 2>&1; then
+    echo "fuzz.sh: $t FAILED; reproducer(s) in $crashes/, log $BUILD/$t.log:"
+    grep -E "ERROR|SUMMARY|Test unit written" "$BUILD/$t.log" | head -5
+    status=1
+  else
+    grep -E "stat::number_of_executed_units|cov:" "$BUILD/$t.log" | tail -2 | tr '\n' ' '; echo
+  fi
+done
+exit $status
