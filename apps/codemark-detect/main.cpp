@@ -12,6 +12,7 @@
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <tclap/CmdLine.h>
@@ -74,12 +75,13 @@ struct Runner
 	/** Pose options: the pipeline's, calibrated for this detector. */
 	pose::PoseOptions pose = pipeline::detectorCalibratedPoseOptions();
 	std::string draw_dir, debug_dir;
-	bool warned_size = false;
 	int failures = 0;
 
 	void fail(const std::string& name, const std::string& why)
 	{
 		std::cout << detect::errorToJson(name, why) << std::endl;
+		// The same one line on stderr, for people and scripts that watch it.
+		std::cerr << "codemark-detect: " << name << ": " << why << "\n";
 		++failures;
 	}
 
@@ -90,11 +92,15 @@ struct Runner
 			fail(name, "not a colour image");
 			return;
 		}
-		if (!warned_size && (img.cols != camera.width() || img.rows != camera.height()))
+		// Intrinsics are only valid for the resolution they were calibrated
+		// at: another size would give a silently wrong P, L and pose.
+		if (img.cols != camera.width() || img.rows != camera.height())
 		{
-			std::cerr << "warning: " << name << " is " << img.cols << "x" << img.rows << " but the camera is "
-					  << camera.width() << "x" << camera.height() << "; P uses the camera's intrinsics as given\n";
-			warned_size = true;
+			fail(name, "image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+						   " but the camera is " + std::to_string(camera.width()) + "x" +
+						   std::to_string(camera.height()) +
+						   ": pass --camera with this image's calibration");
+			return;
 		}
 		std::string dbg;
 		if (!debug_dir.empty())
@@ -150,7 +156,7 @@ struct Runner
 		cv::Mat img;
 		try
 		{
-			img = cv::imread(path, cv::IMREAD_COLOR);
+			img = cv::imread(path, cv::IMREAD_UNCHANGED);
 		}
 		catch (const std::exception& e)
 		{
@@ -159,9 +165,23 @@ struct Runner
 		}
 		if (img.empty())
 		{
-			fail(path, "cannot read the image (missing, unreadable or not an image)");
+			fail(path, "cannot read the image (missing, empty, unreadable or not an image)");
 			return;
 		}
+		// Refuse rather than silently rescale or invent colour: the detector
+		// segments the green fill in 8-bit colour.
+		if (img.depth() != CV_8U)
+		{
+			fail(path, "the image has " + std::to_string(8 * img.elemSize1()) +
+						   "-bit samples; codemark needs 8-bit colour images");
+			return;
+		}
+		if (img.channels() == 1)
+		{
+			fail(path, "grey image; codemark needs colour images (it segments the green fill)");
+			return;
+		}
+		if (img.channels() == 4) cv::cvtColor(img, img, cv::COLOR_BGRA2BGR);
 		process(path, img);
 	}
 
@@ -247,6 +267,9 @@ int main(int argc, char** argv)
 			"Image files, folders (every image inside, sorted by name; not recursive) or video "
 			"files (.mp4, .avi, .mkv, ...; frames named VIDEO#N, N from 0).",
 			true, "INPUT", cmd);
+		// Our own one-line error per unreadable input replaces OpenCV's
+		// decoder warnings on stderr.
+		cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
 		cmd.parse(argc, argv);
 
 		// Single-threaded: time_ms is the detector's own, comparable figure.

@@ -11,6 +11,7 @@
 
 #include "live_view.h"
 #include "progress.h"
+#include "rawlog_check.h"
 
 namespace
 {
@@ -78,6 +79,8 @@ int main(int argc, char** argv)
 		req.gt_file = gt.getValue();
 		req.gt_map_file = gt_map.getValue();
 		req.out_dir = out.getValue();
+		// MRPT reads a corrupt gzip stream as a clean end of file: check first.
+		codemark::app::checkRawlogGzip(req.rawlog);
 		if (gui_every.getValue() < 1) throw std::invalid_argument("--gui-every must be >= 1");
 		std::unique_ptr<codemark::app::LiveView> view;
 		if (gui.getValue())
@@ -102,6 +105,11 @@ int main(int argc, char** argv)
 					   })
 				 : codemark::filters::StepObserver());
 		bar.finish();
+		if (s.steps == 0)
+			throw std::runtime_error(
+				req.rawlog +
+				": no camera frame to localize from (no CObservationImage, CObservationCodedLandmarks "
+				"or CObservationBearingRange in the rawlog)");
 		if (view)
 		{
 			view->finish(s, used_map, false);
