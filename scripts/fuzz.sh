@@ -24,22 +24,33 @@ fi
 # OpenCV and MRPT are not instrumented; their one-time allocations are not leaks of ours.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0:abort_on_error=1:symbolize=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
-status=0
-for t in "${TARGETS[@]}"; do
-  corpus_seed=fuzz/corpus/$t
-  work=$BUILD/corpus/$t           # grows during the run; the committed seeds stay small
-  crashes=fuzz/crashes/$t
+# The targets run side by side (FUZZ_PARALLEL=0 runs them one after the
+# other): each still runs SECONDS of wall time, and CI spends SECONDS in all.
+run_one() {
+  local t=$1
+  local corpus_seed=fuzz/corpus/$t
+  local work=$BUILD/corpus/$t           # grows during the run; the committed seeds stay small
+  local crashes=fuzz/crashes/$t
   mkdir -p "$work" "$crashes"
-  echo "fuzz.sh: $t for ${SECONDS_PER_TARGET} s"
   if ! "$BUILD/fuzz/$t" "$work" "$corpus_seed" -max_total_time="$SECONDS_PER_TARGET" \
       -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
       -artifact_prefix="$crashes/" \
       >"$BUILD/$t.log" 2>&1; then
     echo "fuzz.sh: $t FAILED; reproducer(s) in $crashes/, log $BUILD/$t.log:"
     grep -E "ERROR|SUMMARY|Test unit written" "$BUILD/$t.log" | head -5
-    status=1
+    return 1
+  fi
+  echo "fuzz.sh: $t ran ${SECONDS_PER_TARGET} s: $(grep -E "stat::number_of_executed_units" "$BUILD/$t.log" | tail -1)"
+}
+status=0
+declare -a pids
+for t in "${TARGETS[@]}"; do
+  echo "fuzz.sh: $t for ${SECONDS_PER_TARGET} s"
+  if [[ "${FUZZ_PARALLEL:-1}" == 1 ]]; then
+    run_one "$t" & pids+=($!)
   else
-    grep -E "stat::number_of_executed_units|cov:" "$BUILD/$t.log" | tail -2 | tr '\n' ' '; echo
+    run_one "$t" || status=1
   fi
 done
+for p in "${pids[@]}"; do wait "$p" || status=1; done
 exit $status
