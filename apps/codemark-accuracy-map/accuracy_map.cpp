@@ -40,7 +40,8 @@ std::string fmt(double v, int prec)
 void accumulate(MethodErrors& e, const pose::Measurement& m, const SightingTruth& t)
 {
 	const Eigen::Vector3d dL(m.L[0] - t.L[0], wrapToPi(m.L[1] - t.L[1]), wrapToPi(m.L[2] - t.L[2]));
-	const Eigen::Vector3d dR(m.pose_in_landmark[0] - t.pose_in_landmark[0],
+	const Eigen::Vector3d dR(
+		m.pose_in_landmark[0] - t.pose_in_landmark[0],
 		m.pose_in_landmark[1] - t.pose_in_landmark[1],
 		wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]));
 	++e.detected;
@@ -65,7 +66,9 @@ void finish(MethodErrors& e)
 {
 	if (e.detected == 0) return;
 	const double n = e.detected;
-	for (double* v : {&e.l2_m, &e.phi1_rad, &e.phi2_rad, &e.x_m, &e.y_m, &e.theta_rad, &e.position_m, &e.nees, &e.nees_L})
+	for (double* v :
+		 {&e.l2_m, &e.phi1_rad, &e.phi2_rad, &e.x_m, &e.y_m, &e.theta_rad, &e.position_m, &e.nees,
+		  &e.nees_L})
 		*v /= n;
 }
 
@@ -73,7 +76,7 @@ void finish(MethodErrors& e)
 // detected corners are the outer corners of the black border (8 cells).
 struct TagRenderer
 {
-	std::vector<uint8_t> cells;  // 10 x 10, row 0 at the top as seen from the front
+	std::vector<uint8_t> cells;	 // 10 x 10, row 0 at the top as seen from the front
 	int n = 10;
 	double cell_m;
 
@@ -99,21 +102,25 @@ struct TagRenderer
 		const int col = static_cast<int>(std::floor(s / cell_m + 0.5 * n));
 		const int row = static_cast<int>(std::floor(0.5 * n - t / cell_m));
 		if (col < 0 || row < 0 || col >= n || row >= n) return -1;
-		return cells[row * n + col] ? 235 : 25;  // printed white / black, as the renderer
+		return cells[row * n + col] ? 235 : 25;	 // printed white / black, as the renderer
 	}
 
 	// Pinhole render (the camera's distortion is ignored: the survey uses an
 	// undistorted camera), area-sampled: 4 x 4 samples, 32 x 32 where they
 	// disagree (edge position error about 1/64 px), then blur and noise.
-	cv::Mat render(const CameraModel& cam, const CPose3D& landmark_T_camera, double blur,
-		double noise, uint64_t seed) const
+	cv::Mat render(
+		const CameraModel& cam, const CPose3D& landmark_T_camera, double blur, double noise,
+		uint64_t seed) const
 	{
 		const Eigen::Matrix3d R = landmark_T_camera.getRotationMatrix().asEigen();
-		const Eigen::Vector3d o(landmark_T_camera.x(), landmark_T_camera.y(), landmark_T_camera.z());
+		const Eigen::Vector3d o(
+			landmark_T_camera.x(), landmark_T_camera.y(), landmark_T_camera.z());
 		const double bg = 128;
 		cv::Mat img(cam.height(), cam.width(), CV_32F);
-		const auto value = [&](double u, double v) {
-			const Eigen::Vector3d d = R * Eigen::Vector3d((u - cam.cx()) / cam.fx(), (v - cam.cy()) / cam.fy(), 1);
+		const auto value = [&](double u, double v)
+		{
+			const Eigen::Vector3d d =
+				R * Eigen::Vector3d((u - cam.cx()) / cam.fx(), (v - cam.cy()) / cam.fy(), 1);
 			const int g = sample(o, d);
 			return g < 0 ? bg : g;
 		};
@@ -187,7 +194,8 @@ struct TagDetector
 	}
 
 	// Corners of tag #0, matched to the nearest of \a expected (TL TR BR BL).
-	bool detect(const cv::Mat& grey, const std::array<Eigen::Vector2d, 4>& expected,
+	bool detect(
+		const cv::Mat& grey, const std::array<Eigen::Vector2d, 4>& expected,
 		std::array<Eigen::Vector2d, 4>& out) const
 	{
 		image_u8_t im{grey.cols, grey.rows, static_cast<int32_t>(grey.step), grey.data};
@@ -222,7 +230,8 @@ struct TagDetector
 }  // namespace
 
 std::vector<CellResult> runSurvey(
-	const CameraModel& camera, const SurveyOptions& o, const std::function<void(long, long)>& progress)
+	const CameraModel& camera, const SurveyOptions& o,
+	const std::function<void(long, long)>& progress)
 {
 	if (!(o.cell_m > 0) || o.renders_per_cell < 1)
 		throw std::invalid_argument("survey: cell_m must be > 0 and renders_per_cell >= 1");
@@ -248,7 +257,9 @@ std::vector<CellResult> runSurvey(
 		for (double Y = 0; Y <= o.max_distance_m + 1e-9; Y += o.cell_m)
 		{
 			const double d = std::hypot(X, Y), a = std::atan2(Y, X) * 180 / M_PI;
-			if (d < o.min_distance_m - 1e-9 || d > o.max_distance_m + 1e-9 || a > o.max_angle_deg + 1e-9) continue;
+			if (d < o.min_distance_m - 1e-9 || d > o.max_distance_m + 1e-9 ||
+				a > o.max_angle_deg + 1e-9)
+				continue;
 			CellResult c;
 			c.X_m = X;
 			c.Y_m = Y;
@@ -260,7 +271,8 @@ std::vector<CellResult> runSurvey(
 	long done = 0;
 	for (CellResult& c : cells)
 	{
-		scene.world_T_camera = sim::levelCameraLookingAt(lm, c.distance_m, c.angle_deg * M_PI / 180);
+		scene.world_T_camera =
+			sim::levelCameraLookingAt(lm, c.distance_m, c.angle_deg * M_PI / 180);
 		const CPose3D landmark_T_camera = scene.world_T_camera - lm.world_T_landmark();
 		const SightingTruth truth = sightingTruth(landmark_T_camera);
 		// Predicted sigmas at the exact corners.
@@ -302,7 +314,8 @@ std::vector<CellResult> runSurvey(
 			}
 			if (o.apriltag)
 			{
-				const cv::Mat grey = tag.render(camera, landmark_T_camera, o.blur_sigma_px, o.noise_sigma, seed);
+				const cv::Mat grey =
+					tag.render(camera, landmark_T_camera, o.blur_sigma_px, o.noise_sigma, seed);
 				std::array<Eigen::Vector2d, 4> corners;
 				if (tagdet.detect(grey, img.truth[0].corners_px, corners))
 				{
@@ -348,7 +361,8 @@ namespace
 // Heat map of one metric: measured mean absolute error (left) beside the
 // predicted sigma (right), one square per cell, X_L down and Y_L right as in
 // Fig. 3, a shared logarithmic colour scale.
-void heatMap(const std::vector<CellResult>& cells, const SurveyOptions& o, const std::string& path,
+void heatMap(
+	const std::vector<CellResult>& cells, const SurveyOptions& o, const std::string& path,
 	const std::string& title, const std::string& unit, double to_unit,
 	const std::function<double(const CellResult&)>& measured,
 	const std::function<double(const CellResult&)>& predicted)
@@ -356,7 +370,8 @@ void heatMap(const std::vector<CellResult>& cells, const SurveyOptions& o, const
 	const int cp = 56, header = 50, margin = 30;
 	const int nx = static_cast<int>(std::lround(o.max_distance_m / o.cell_m));
 	const int panel_w = (nx + 1) * cp, panel_h = nx * cp;
-	cv::Mat img(header + panel_h + margin, 2 * panel_w + 3 * margin, CV_8UC3, cv::Scalar(255, 255, 255));
+	cv::Mat img(
+		header + panel_h + margin, 2 * panel_w + 3 * margin, CV_8UC3, cv::Scalar(255, 255, 255));
 	double lo = 1e300, hi = 0;
 	for (const auto& c : cells)
 		for (const double v : {measured(c), predicted(c)})
@@ -370,7 +385,8 @@ void heatMap(const std::vector<CellResult>& cells, const SurveyOptions& o, const
 	for (int panel = 0; panel < 2; ++panel)
 	{
 		const int x0 = margin + panel * (panel_w + margin), y0 = header;
-		cv::putText(img, panel == 0 ? "measured mean |error|" : "predicted sigma", cv::Point(x0, y0 - 8),
+		cv::putText(
+			img, panel == 0 ? "measured mean |error|" : "predicted sigma", cv::Point(x0, y0 - 8),
 			cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 		for (const auto& c : cells)
 		{
@@ -381,10 +397,14 @@ void heatMap(const std::vector<CellResult>& cells, const SurveyOptions& o, const
 			if (!(v > 0) || !std::isfinite(v))
 			{
 				cv::rectangle(img, r, cv::Scalar(200, 200, 200), cv::FILLED);
-				cv::putText(img, "n/a", r.tl() + cv::Point(14, 32), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+				cv::putText(
+					img, "n/a", r.tl() + cv::Point(14, 32), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+					cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 				continue;
 			}
-			cv::Mat one(1, 1, CV_8U, cv::Scalar(static_cast<int>(255 * (std::log10(v) - llo) / (lhi - llo))));
+			cv::Mat one(
+				1, 1, CV_8U,
+				cv::Scalar(static_cast<int>(255 * (std::log10(v) - llo) / (lhi - llo))));
 			cv::Mat rgb;
 			cv::applyColorMap(one, rgb, cv::COLORMAP_VIRIDIS);
 			const cv::Vec3b k = rgb.at<cv::Vec3b>(0, 0);
@@ -392,13 +412,23 @@ void heatMap(const std::vector<CellResult>& cells, const SurveyOptions& o, const
 			const double lum = 0.114 * k[0] + 0.587 * k[1] + 0.299 * k[2];
 			const cv::Scalar tc = lum > 128 ? cv::Scalar(0, 0, 0) : cv::Scalar(255, 255, 255);
 			const double vu = v * to_unit;
-			cv::putText(img, fmt(vu, vu < 1 ? 3 : vu < 10 ? 2 : vu < 100 ? 1 : 0), r.tl() + cv::Point(4, 32),
-				cv::FONT_HERSHEY_SIMPLEX, 0.4, tc, 1, cv::LINE_AA);
+			cv::putText(
+				img,
+				fmt(vu, vu < 1	   ? 3
+						: vu < 10  ? 2
+						: vu < 100 ? 1
+								   : 0),
+				r.tl() + cv::Point(4, 32), cv::FONT_HERSHEY_SIMPLEX, 0.4, tc, 1, cv::LINE_AA);
 		}
 		// The landmark above the first row at Y = 0.
-		cv::rectangle(img, cv::Point(x0 - 6, y0 - 4), cv::Point(x0 + 6, y0 - 1), cv::Scalar(0, 160, 0), cv::FILLED);
+		cv::rectangle(
+			img, cv::Point(x0 - 6, y0 - 4), cv::Point(x0 + 6, y0 - 1), cv::Scalar(0, 160, 0),
+			cv::FILLED);
 	}
-	cv::putText(img, title + " [" + unit + "]: rows X_L = " + fmt(o.cell_m, 1) + ".." + fmt(o.max_distance_m, 1) +
+	cv::putText(
+		img,
+		title + " [" + unit + "]: rows X_L = " + fmt(o.cell_m, 1) + ".." +
+			fmt(o.max_distance_m, 1) +
 			" m down, columns Y_L = 0.. right; landmark (green) top-left",
 		cv::Point(margin, 20), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
@@ -416,42 +446,52 @@ double chi2Quantile(double p, double k)
 }
 }  // namespace
 
-std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptions& o, const std::string& dir)
+std::string writeResults(
+	const std::vector<CellResult>& cells, const SurveyOptions& o, const std::string& dir)
 {
 	std::filesystem::create_directories(dir);
 	const std::string csv = dir + "/cells.csv";
 	std::ofstream f(csv);
 	if (!f) throw std::runtime_error("cannot write " + csv);
-	f << "X_m,Y_m,distance_m,angle_deg,renders,sigma_l2_m,sigma_phi1_rad,sigma_phi2_rad,sigma_x_m,sigma_y_m";
+	f << "X_m,Y_m,distance_m,angle_deg,renders,sigma_l2_m,sigma_phi1_rad,sigma_phi2_rad,sigma_x_m,"
+		 "sigma_y_m";
 	for (const char* m : {"cf", "gen", "tag"})
-		for (const char* k : {"detected", "l2_m", "phi1_rad", "phi2_rad", "x_m", "y_m", "theta_rad", "position_m", "nees"})
+		for (const char* k :
+			 {"detected", "l2_m", "phi1_rad", "phi2_rad", "x_m", "y_m", "theta_rad", "position_m",
+			  "nees"})
 			f << "," << m << "_" << k;
-	f << ",corner_dx_px,corner_dy_px,corner_rms_px,tag_corner_dx_px,tag_corner_dy_px,tag_corner_rms_px";
+	f << ",corner_dx_px,corner_dy_px,corner_rms_px,tag_corner_dx_px,tag_corner_dy_px,tag_corner_"
+		 "rms_px";
 	f << "\n" << std::setprecision(9);
 	for (const auto& c : cells)
 	{
-		f << c.X_m << "," << c.Y_m << "," << c.distance_m << "," << c.angle_deg << "," << c.renders << ","
-		  << c.sigma_l2_m << "," << c.sigma_phi1_rad << "," << c.sigma_phi2_rad << "," << c.sigma_x_m << ","
-		  << c.sigma_y_m;
+		f << c.X_m << "," << c.Y_m << "," << c.distance_m << "," << c.angle_deg << "," << c.renders
+		  << "," << c.sigma_l2_m << "," << c.sigma_phi1_rad << "," << c.sigma_phi2_rad << ","
+		  << c.sigma_x_m << "," << c.sigma_y_m;
 		for (const MethodErrors* e : {&c.closed_form, &c.general, &c.apriltag})
-			f << "," << e->detected << "," << e->l2_m << "," << e->phi1_rad << "," << e->phi2_rad << "," << e->x_m
-			  << "," << e->y_m << "," << e->theta_rad << "," << e->position_m << "," << e->nees;
-		f << "," << c.corner_dx_px << "," << c.corner_dy_px << "," << c.corner_rms_px << "," << c.tag_corner_dx_px
-		  << "," << c.tag_corner_dy_px << "," << c.tag_corner_rms_px;
+			f << "," << e->detected << "," << e->l2_m << "," << e->phi1_rad << "," << e->phi2_rad
+			  << "," << e->x_m << "," << e->y_m << "," << e->theta_rad << "," << e->position_m
+			  << "," << e->nees;
+		f << "," << c.corner_dx_px << "," << c.corner_dy_px << "," << c.corner_rms_px << ","
+		  << c.tag_corner_dx_px << "," << c.tag_corner_dy_px << "," << c.tag_corner_rms_px;
 		f << "\n";
 	}
 
 	const auto cf = [](const CellResult& c) -> const MethodErrors& { return c.closed_form; };
-	heatMap(cells, o, dir + "/heat_l2.png", "l2 (range), closed form", "mm", 1000,
+	heatMap(
+		cells, o, dir + "/heat_l2.png", "l2 (range), closed form", "mm", 1000,
 		[&](const CellResult& c) { return cf(c).detected ? cf(c).l2_m : NAN; },
 		[](const CellResult& c) { return c.sigma_l2_m; });
-	heatMap(cells, o, dir + "/heat_phi2.png", "phi2, closed form", "deg", 180 / M_PI,
+	heatMap(
+		cells, o, dir + "/heat_phi2.png", "phi2, closed form", "deg", 180 / M_PI,
 		[&](const CellResult& c) { return cf(c).detected ? cf(c).phi2_rad : NAN; },
 		[](const CellResult& c) { return c.sigma_phi2_rad; });
-	heatMap(cells, o, dir + "/heat_x.png", "x of the camera in L, closed form", "mm", 1000,
+	heatMap(
+		cells, o, dir + "/heat_x.png", "x of the camera in L, closed form", "mm", 1000,
 		[&](const CellResult& c) { return cf(c).detected ? cf(c).x_m : NAN; },
 		[](const CellResult& c) { return c.sigma_x_m; });
-	heatMap(cells, o, dir + "/heat_y.png", "y of the camera in L, closed form", "mm", 1000,
+	heatMap(
+		cells, o, dir + "/heat_y.png", "y of the camera in L, closed form", "mm", 1000,
 		[&](const CellResult& c) { return cf(c).detected ? cf(c).y_m : NAN; },
 		[](const CellResult& c) { return c.sigma_y_m; });
 
@@ -461,21 +501,25 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 		std::string name;
 		double dmin, dmax, amax;
 	};
-	const std::vector<Region> regions{{"within 2 m, all angles", 0, 2.0 + 1e-9, 90},
+	const std::vector<Region> regions{
+		{"within 2 m, all angles", 0, 2.0 + 1e-9, 90},
 		{"within 2 m, in front (<= 30 deg)", 0, 2.0 + 1e-9, 30 + 1e-9},
 		{"2 to 5 m, all angles", 2.0 + 1e-9, 5.0 + 1e-9, 90}};
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
 	  << o.renders_per_cell << " renders each, noise " << fmt(o.noise_sigma, 1) << ", blur "
 	  << fmt(o.blur_sigma_px, 2) << " px, C_P " << o.noise_label << "\n";
-	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general 6-DoF,"
-		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's sigma)\n";
+	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general "
+		 "6-DoF,"
+		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's "
+		 "sigma)\n";
 	for (const Region& r : regions)
 	{
 		s << "\n## " << r.name << "\n";
 		s << "metric            ";
 		for (const char* m : {"cf", "gen", "tag"}) s << std::setw(12) << m;
-		s << std::setw(14) << "pred sigma" << "\n";
+		s << std::setw(14) << "pred sigma"
+		  << "\n";
 		struct Acc
 		{
 			double sum[3] = {0, 0, 0};
@@ -483,13 +527,17 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			double pred = 0;
 			int np = 0;
 		};
-		const auto row = [&](const std::string& name, const std::function<double(const MethodErrors&, const CellResult&)>& get,
-							 const std::function<double(const CellResult&)>& pred, double unit, int prec) {
+		const auto row =
+			[&](const std::string& name,
+				const std::function<double(const MethodErrors&, const CellResult&)>& get,
+				const std::function<double(const CellResult&)>& pred, double unit, int prec)
+		{
 			Acc a;
 			int cells_total = 0, detected[3] = {0, 0, 0}, renders = 0;
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
+					continue;
 				++cells_total;
 				renders += c.renders;
 				const MethodErrors* e[3] = {&c.closed_form, &c.general, &c.apriltag};
@@ -508,25 +556,41 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			}
 			s << std::left << std::setw(18) << name << std::right;
 			for (int k = 0; k < 3; ++k)
-				s << std::setw(12) << (a.n[k] ? fmt(a.sum[k] / a.n[k] * unit, prec) : std::string("-"));
-			s << std::setw(14) << (a.np ? fmt(a.pred / a.np * unit, prec) : std::string("")) << "\n";
+				s << std::setw(12)
+				  << (a.n[k] ? fmt(a.sum[k] / a.n[k] * unit, prec) : std::string("-"));
+			s << std::setw(14) << (a.np ? fmt(a.pred / a.np * unit, prec) : std::string(""))
+			  << "\n";
 			return std::make_tuple(cells_total, renders, detected[0], detected[1], detected[2]);
 		};
-		row("range [% of l2]", [](const MethodErrors& e, const CellResult& c) { return e.l2_m / c.distance_m; },
+		row(
+			"range [% of l2]",
+			[](const MethodErrors& e, const CellResult& c) { return e.l2_m / c.distance_m; },
 			[](const CellResult& c) { return c.sigma_l2_m / c.distance_m; }, 100, 4);
-		row("bearing phi1 [deg]", [](const MethodErrors& e, const CellResult&) { return e.phi1_rad; },
+		row(
+			"bearing phi1 [deg]",
+			[](const MethodErrors& e, const CellResult&) { return e.phi1_rad; },
 			[](const CellResult& c) { return c.sigma_phi1_rad; }, 180 / M_PI, 4);
-		row("phi2 [deg]", [](const MethodErrors& e, const CellResult&) { return e.phi2_rad; },
+		row(
+			"phi2 [deg]", [](const MethodErrors& e, const CellResult&) { return e.phi2_rad; },
 			[](const CellResult& c) { return c.sigma_phi2_rad; }, 180 / M_PI, 3);
-		row("x [mm]", [](const MethodErrors& e, const CellResult&) { return e.x_m; },
+		row(
+			"x [mm]", [](const MethodErrors& e, const CellResult&) { return e.x_m; },
 			[](const CellResult& c) { return c.sigma_x_m; }, 1000, 2);
-		row("y [mm]", [](const MethodErrors& e, const CellResult&) { return e.y_m; },
+		row(
+			"y [mm]", [](const MethodErrors& e, const CellResult&) { return e.y_m; },
 			[](const CellResult& c) { return c.sigma_y_m; }, 1000, 2);
-		row("position [mm]", [](const MethodErrors& e, const CellResult&) { return e.position_m; }, {}, 1000, 2);
-		row("heading [deg]", [](const MethodErrors& e, const CellResult&) { return e.theta_rad; }, {}, 180 / M_PI, 3);
-		const auto [nc, nr, d0, d1, d2] = row("mean NEES (3 dof)",
-			[](const MethodErrors& e, const CellResult&) { return e.nees; }, {}, 1, 2);
-		row("mean NEES of L", [](const MethodErrors& e, const CellResult&) { return e.nees_L; }, {}, 1, 2);
+		row(
+			"position [mm]", [](const MethodErrors& e, const CellResult&) { return e.position_m; },
+			{}, 1000, 2);
+		row(
+			"heading [deg]", [](const MethodErrors& e, const CellResult&) { return e.theta_rad; },
+			{}, 180 / M_PI, 3);
+		const auto [nc, nr, d0, d1, d2] = row(
+			"mean NEES (3 dof)", [](const MethodErrors& e, const CellResult&) { return e.nees; },
+			{}, 1, 2);
+		row(
+			"mean NEES of L", [](const MethodErrors& e, const CellResult&) { return e.nees_L; }, {},
+			1, 2);
 		{
 			// Pose NEES pooled over the sightings whose reported phi2 sigma
 			// is at most 2 deg, with its own 95% band.
@@ -537,14 +601,16 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 				int n = 0;
 				for (const auto& c : cells)
 				{
-					if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+					if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
+						continue;
 					const MethodErrors& e = k ? c.general : c.closed_form;
 					sum += e.nees_small_phi2_sum;
 					n += e.nees_small_phi2_n;
 				}
 				s << (k ? "; gen " : " cf ");
 				if (n)
-					s << fmt(sum / n, 2) << " over " << n << " [" << fmt(chi2Quantile(0.025, 3.0 * n) / n, 2) << ", "
+					s << fmt(sum / n, 2) << " over " << n << " ["
+					  << fmt(chi2Quantile(0.025, 3.0 * n) / n, 2) << ", "
 					  << fmt(chi2Quantile(0.975, 3.0 * n) / n, 2) << "]";
 				else
 					s << "-";
@@ -560,7 +626,8 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			int n[2] = {0, 0};
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
+					continue;
 				const MethodErrors* e[2] = {&c.closed_form, &c.general};
 				for (int k = 0; k < 2; ++k)
 					if (e[k]->detected)
@@ -571,7 +638,9 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			}
 			s << "sigma_px for mean NEES 3:";
 			for (int k = 0; k < 2; ++k)
-				s << (k ? ", gen " : " cf ") << (n[k] ? fmt(o.pose.sigma_px * std::sqrt(sum[k] / n[k] / 3), 4) : std::string("-"));
+				s << (k ? ", gen " : " cf ")
+				  << (n[k] ? fmt(o.pose.sigma_px * std::sqrt(sum[k] / n[k] / 3), 4)
+						   : std::string("-"));
 			s << "\n";
 		}
 		{
@@ -579,7 +648,8 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 			int n = 0, tn = 0;
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax) continue;
+				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
+					continue;
 				if (c.closed_form.detected)
 				{
 					dx += c.corner_dx_px;
@@ -596,20 +666,24 @@ std::string writeResults(const std::vector<CellResult>& cells, const SurveyOptio
 				}
 			}
 			if (n)
-				s << "corner error [px]: codemark mean (" << fmt(dx / n, 4) << ", " << fmt(dy / n, 4) << "), rms "
-				  << fmt(std::sqrt(rms / n), 4);
+				s << "corner error [px]: codemark mean (" << fmt(dx / n, 4) << ", "
+				  << fmt(dy / n, 4) << "), rms " << fmt(std::sqrt(rms / n), 4);
 			if (tn)
-				s << "; AprilTag mean (" << fmt(tdx / tn, 4) << ", " << fmt(tdy / tn, 4) << "), rms "
-				  << fmt(std::sqrt(trms / tn), 4);
+				s << "; AprilTag mean (" << fmt(tdx / tn, 4) << ", " << fmt(tdy / tn, 4)
+				  << "), rms " << fmt(std::sqrt(trms / tn), 4);
 			s << "\n";
 		}
-		s << "cells " << nc << ", renders " << nr << ", detected cf/gen/tag " << d0 << "/" << d1 << "/" << d2 << "\n";
+		s << "cells " << nc << ", renders " << nr << ", detected cf/gen/tag " << d0 << "/" << d1
+		  << "/" << d2 << "\n";
 		if (d0 > 0)
-			s << "95% band of the mean NEES over " << d0 << " sightings: [" << fmt(chi2Quantile(0.025, 3.0 * d0) / d0, 3)
-			  << ", " << fmt(chi2Quantile(0.975, 3.0 * d0) / d0, 3) << "]\n";
+			s << "95% band of the mean NEES over " << d0 << " sightings: ["
+			  << fmt(chi2Quantile(0.025, 3.0 * d0) / d0, 3) << ", "
+			  << fmt(chi2Quantile(0.975, 3.0 * d0) / d0, 3) << "]\n";
 	}
-	s << "\n# paper (real images, 1 px sigma): about 50 mm in x and y and < 2 deg within 2 m in front\n"
-		 "# issue 4 targets (within 2 m): range <= 0.05%, bearing <= 0.005 deg, phi2 <= 0.4 deg, position <= 10 mm;"
+	s << "\n# paper (real images, 1 px sigma): about 50 mm in x and y and < 2 deg within 2 m in "
+		 "front\n"
+		 "# issue 4 targets (within 2 m): range <= 0.05%, bearing <= 0.005 deg, phi2 <= 0.4 deg, "
+		 "position <= 10 mm;"
 		 " 2-5 m: range <= 0.15%, bearing <= 0.005 deg, phi2 <= 2 deg; NEES in the 95% band\n";
 	const std::string text = s.str();
 	std::ofstream sf(dir + "/summary.txt");

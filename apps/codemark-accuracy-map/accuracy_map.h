@@ -25,10 +25,10 @@ struct SurveyOptions
 	double cell_m = 0.5;  //!< grid step [m]
 	double min_distance_m = 0.5;  //!< cells closer than this are skipped [m]
 	double max_distance_m = 5.0;  //!< cells farther than this are skipped [m]
-	double max_angle_deg = 70;  //!< cells beyond this view angle are skipped [deg]
+	double max_angle_deg = 70;	//!< cells beyond this view angle are skipped [deg]
 	int renders_per_cell = 5;  //!< noisy renders per cell (different seeds)
 	double noise_sigma = 2.0;  //!< renderer pixel noise [grey levels]
-	double blur_sigma_px = 0.8;  //!< renderer blur [px]
+	double blur_sigma_px = 0.8;	 //!< renderer blur [px]
 	/** Noise model of P for C_L, C_R (the method field is ignored: both paths
 	 * run). Default: codemark::pipeline::detectorCalibratedPoseOptions(),
 	 * the detector's calibrated, size-dependent C_P. */
@@ -36,7 +36,7 @@ struct SurveyOptions
 	/** A one-line description of \a pose's noise model for the summary. */
 	std::string noise_label = "calibrated (pipeline::detectorCalibratedPoseOptions)";
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path
-	uint64_t seed = 1;  //!< first render seed
+	uint64_t seed = 1;	//!< first render seed
 };
 
 /** Mean absolute errors over the renders of one cell for one method. */
@@ -44,10 +44,10 @@ struct MethodErrors
 {
 	int detected = 0;  //!< renders where the method found the landmark
 	double l2_m = 0, phi1_rad = 0, phi2_rad = 0;  //!< mean |error| of L
-	double x_m = 0, y_m = 0, theta_rad = 0;  //!< mean |error| of the pose in L
-	double position_m = 0;  //!< mean Euclidean position error in L
+	double x_m = 0, y_m = 0, theta_rad = 0;	 //!< mean |error| of the pose in L
+	double position_m = 0;	//!< mean Euclidean position error in L
 	double nees = 0;  //!< mean NEES of the pose with the reported C_R (3 dof)
-	double nees_L = 0;  //!< mean NEES of L with the reported C_L (3 dof)
+	double nees_L = 0;	//!< mean NEES of L with the reported C_L (3 dof)
 	/** Sum and count of the pose NEES over the sightings whose reported phi2
 	 * sigma is at most 2 deg (where a Gaussian C_R can hold). */
 	double nees_small_phi2_sum = 0;

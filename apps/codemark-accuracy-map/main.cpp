@@ -26,26 +26,37 @@ int main(int argc, char** argv)
 			"summary.txt (the table against the paper's claims) into --out. With AprilTag 3 "
 			"(tag36h11, same corner-square size) at the same poses as a comparison column.",
 			' ', "0.1.0");
-		TCLAP::ValueArg<std::string> out_arg("", "out", "Output folder (created).", true, "", "DIR", cmd);
-		TCLAP::ValueArg<std::string> camera_arg("", "camera",
+		TCLAP::ValueArg<std::string> out_arg(
+			"", "out", "Output folder (created).", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> camera_arg(
+			"", "camera",
 			"Camera file (MRPT ini or YAML). Default: the paper's camera. The AprilTag column "
 			"ignores lens distortion.",
 			false, "", "FILE", cmd);
-		TCLAP::ValueArg<int> renders_arg("", "renders", "Noisy renders per cell. Default 5.", false, 5, "N", cmd);
-		TCLAP::ValueArg<double> cell_arg("", "cell", "Grid step [m]. Default 0.5.", false, 0.5, "M", cmd);
-		TCLAP::ValueArg<double> maxd_arg("", "max-distance", "Farthest cell [m]. Default 5.", false, 5.0, "M", cmd);
-		TCLAP::ValueArg<double> noise_arg("", "noise", "Render noise sigma [grey levels]. Default 2.", false, 2.0, "S", cmd);
-		TCLAP::ValueArg<double> blur_arg("", "blur", "Render blur sigma [px]. Default 0.8.", false, 0.8, "PX", cmd);
-		TCLAP::ValueArg<double> sigma_arg("", "sigma-px",
+		TCLAP::ValueArg<int> renders_arg(
+			"", "renders", "Noisy renders per cell. Default 5.", false, 5, "N", cmd);
+		TCLAP::ValueArg<double> cell_arg(
+			"", "cell", "Grid step [m]. Default 0.5.", false, 0.5, "M", cmd);
+		TCLAP::ValueArg<double> maxd_arg(
+			"", "max-distance", "Farthest cell [m]. Default 5.", false, 5.0, "M", cmd);
+		TCLAP::ValueArg<double> noise_arg(
+			"", "noise", "Render noise sigma [grey levels]. Default 2.", false, 2.0, "S", cmd);
+		TCLAP::ValueArg<double> blur_arg(
+			"", "blur", "Render blur sigma [px]. Default 0.8.", false, 0.8, "PX", cmd);
+		TCLAP::ValueArg<double> sigma_arg(
+			"", "sigma-px",
 			"A constant sigma of each component of P for the predicted covariances [px] (the "
 			"spec's diagonal C_P). Default: the detector's calibrated, size-dependent C_P "
 			"(codemark::pipeline::detectorCalibratedPoseOptions).",
 			false, 0, "PX", cmd);
-		TCLAP::ValueArg<std::string> sigma_source_arg("", "sigma-source",
-			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default Fixed.",
+		TCLAP::ValueArg<std::string> sigma_source_arg(
+			"", "sigma-source",
+			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default "
+			"Fixed.",
 			false, "Fixed", "NAME", cmd);
 		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
-		TCLAP::ValueArg<unsigned long> seed_arg("", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
+		TCLAP::ValueArg<unsigned long> seed_arg(
+			"", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
 
@@ -67,12 +78,13 @@ int main(int argc, char** argv)
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
 			o.noise_label = "the detector's per-detection corner sigma";
 		o.seed = seed_arg.getValue();
-		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) || !(o.pose.sigma_px > 0) ||
-			o.noise_sigma < 0 || o.blur_sigma_px < 0)
-			throw std::invalid_argument("--renders >= 1, --cell, --max-distance, --sigma-px > 0, --noise, --blur >= 0");
-		const codemark::CameraModel camera = camera_arg.getValue().empty()
-			? codemark::CameraModel::paperDefault()
-			: codemark::CameraModel::load(camera_arg.getValue());
+		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) ||
+			!(o.pose.sigma_px > 0) || o.noise_sigma < 0 || o.blur_sigma_px < 0)
+			throw std::invalid_argument(
+				"--renders >= 1, --cell, --max-distance, --sigma-px > 0, --noise, --blur >= 0");
+		const codemark::CameraModel camera =
+			camera_arg.getValue().empty() ? codemark::CameraModel::paperDefault()
+										  : codemark::CameraModel::load(camera_arg.getValue());
 		codemark::app::ProgressBar bar("accuracy-map");
 		const auto cells = ca::runSurvey(camera, o, [&](long d, long t) { bar.update(d, t); });
 		bar.finish();
@@ -85,7 +97,8 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-accuracy-map: error: " << e.argId() << ": " << e.error() << " (see --help)\n";
+		std::cerr << "codemark-accuracy-map: error: " << e.argId() << ": " << e.error()
+				  << " (see --help)\n";
 		return 1;
 	}
 	catch (const std::exception& e)

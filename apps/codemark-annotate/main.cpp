@@ -20,7 +20,8 @@ int main(int argc, char** argv)
 	{
 		TCLAP::CmdLine cmd(
 			"Runs codemark's detector and pose computation on every CObservationImage of an MRPT "
-			"rawlog (actions-observations or observations-only format; embedded or external images, "
+			"rawlog (actions-observations or observations-only format; embedded or external "
+			"images, "
 			"looked up in <input name>_Images/ beside the input) and writes a copy with a "
 			"codemark::CObservationCodedLandmarks (label <CAM>_LANDMARKS, the image's timestamp "
 			"and camera pose) right after each image. Open the output with the plugin: "
@@ -28,22 +29,30 @@ int main(int argc, char** argv)
 			"that cannot be read stops the run with its index and a non-zero exit.",
 			' ', "0.1");
 		TCLAP::ValueArg<std::string> in("i", "input", "input rawlog", true, "", "IN.rawlog", cmd);
-		TCLAP::ValueArg<std::string> out("o", "output", "output rawlog", true, "", "OUT.rawlog", cmd);
+		TCLAP::ValueArg<std::string> out(
+			"o", "output", "output rawlog", true, "", "OUT.rawlog", cmd);
 		TCLAP::ValueArg<std::string> camera(
-			"", "camera", "camera file (MRPT ini or ROS/OpenCV YAML) replacing the intrinsics stored "
-			"in the images", false, "", "CAM", cmd);
+			"", "camera",
+			"camera file (MRPT ini or ROS/OpenCV YAML) replacing the intrinsics stored "
+			"in the images",
+			false, "", "CAM", cmd);
 		TCLAP::ValueArg<std::string> landmark(
-			"", "landmark", "landmark sizes ([LANDMARK] section; default share/codemark/landmark.ini)",
-			false, "", "LM.ini", cmd);
+			"", "landmark",
+			"landmark sizes ([LANDMARK] section; default share/codemark/landmark.ini)", false, "",
+			"LM.ini", cmd);
 		TCLAP::ValueArg<std::string> map(
-			"", "map", "landmark map: each ID's scale column sets its size", false, "", "MAP.txt", cmd);
+			"", "map", "landmark map: each ID's scale column sets its size", false, "", "MAP.txt",
+			cmd);
 		TCLAP::ValueArg<std::string> config(
-			"", "config", "ini with [DETECTOR] and [pose] sections (share/codemark/detector.ini "
-			"keys; pose: method = ClosedForm|General6Dof, sigma_px)", false, "", "INI", cmd);
+			"", "config",
+			"ini with [DETECTOR] and [pose] sections (share/codemark/detector.ini "
+			"keys; pose: method = ClosedForm|General6Dof, sigma_px)",
+			false, "", "INI", cmd);
 		TCLAP::SwitchArg br(
 			"", "bearing-range", "also insert the CObservationBearingRange twin (<CAM>_BR)", cmd);
 		TCLAP::SwitchArg drop("", "drop-images", "leave the image observations out", cmd);
-		TCLAP::ValueArg<int> threads("", "threads", "worker threads (0: all cores)", false, 0, "N", cmd);
+		TCLAP::ValueArg<int> threads(
+			"", "threads", "worker threads (0: all cores)", false, 0, "N", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
@@ -55,7 +64,7 @@ int main(int argc, char** argv)
 		if (!camera.getValue().empty())
 			o.pipeline.camera_override = codemark::CameraModel::load(camera.getValue());
 		const std::string lm = landmark.getValue().empty() ? codemark::findShareFile("landmark.ini")
-															: landmark.getValue();
+														   : landmark.getValue();
 		if (!lm.empty())
 		{
 			if (!std::ifstream(lm).good()) throw std::runtime_error(lm + ": cannot open");
@@ -123,7 +132,8 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-annotate: error: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
+		std::cerr << "codemark-annotate: error: "
+				  << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
 	}
 	return 1;
 }

@@ -22,18 +22,18 @@ namespace codemark::bench
 struct Dataset
 {
 	std::string name;  //!< NAME of `[dataset:NAME]`
-	std::string rawlog;  //!< images and/or landmark observations, either format
+	std::string rawlog;	 //!< images and/or landmark observations, either format
 	std::string map;  //!< landmark map (spec section 3) or MRPT landmark file
-	std::string gt;  //!< ground truth, either form of spec section 6
-	std::string camera;  //!< optional camera file: replaces the rawlog's intrinsics
+	std::string gt;	 //!< ground truth, either form of spec section 6
+	std::string camera;	 //!< optional camera file: replaces the rawlog's intrinsics
 };
 
 /** The whole benchmark ini. */
 struct BenchConfig
 {
 	std::string file;  //!< the ini's path
-	std::vector<Dataset> datasets;  //!< in file order
-	std::vector<std::string> methods{"ekf", "ekf-pose", "ekf-slam", "pf"};  //!< `[bench] methods`
+	std::vector<Dataset> datasets;	//!< in file order
+	std::vector<std::string> methods{"ekf", "ekf-pose", "ekf-slam", "pf"};	//!< `[bench] methods`
 	/** Folder of the method inis `<method>.ini` (`[bench] config_dir`,
 	 * default: share/codemark/config). */
 	std::string config_dir;
@@ -66,11 +66,11 @@ struct DetectionStats
 	long frames = 0;  //!< camera frames with a true pose
 	long frames_in_view = 0;  //!< ... where >= 1 landmark is in view (BenchConfig::min_span_px)
 	long frames_detected = 0;  //!< ... and >= 1 of those was detected with its right ID
-	long sightings_in_view = 0;  //!< landmark-frames in view
+	long sightings_in_view = 0;	 //!< landmark-frames in view
 	long sightings_detected = 0;  //!< ... detected with the right ID
-	long wrong_ids = 0;  //!< detections whose ID is not of a landmark that is (even partly) in view
+	long wrong_ids = 0;	 //!< detections whose ID is not of a landmark that is (even partly) in view
 	long images = 0;  //!< images detected on the fly (0: pre-annotated rawlog)
-	double detect_ms_per_image = 0;  //!< wall time per image: load + decode + detect + measure [ms]
+	double detect_ms_per_image = 0;	 //!< wall time per image: load + decode + detect + measure [ms]
 };
 
 /** Relative pose error over a time interval. */
@@ -86,7 +86,7 @@ struct Rpe
 struct Alignment
 {
 	double yaw_rad = 0;
-	double tx = 0, ty = 0;  //!< [m]
+	double tx = 0, ty = 0;	//!< [m]
 	double ate_m = 0;  //!< RMS position error after the alignment [m]
 };
 
@@ -95,12 +95,12 @@ struct JobResult
 {
 	std::string dataset, method;
 	bool ok = false;
-	std::string error;  //!< one line when !ok
+	std::string error;	//!< one line when !ok
 	filters::LocalizeSummary summary;  //!< rows, metrics, first fix, per-step time
 	DetectionStats detection;
 	std::optional<Rpe> rpe;
 	std::optional<Alignment> aligned;  //!< ATE after the best SE(2) alignment
-	double wall_s = 0;  //!< the job's wall time: reading, detection, filtering, outputs [s]
+	double wall_s = 0;	//!< the job's wall time: reading, detection, filtering, outputs [s]
 	std::string out_dir;  //!< where the job's spec section 6 files are
 };
 
@@ -111,8 +111,9 @@ struct JobResult
  * the whole process): the caller must then keep every other job from
  * touching the generator while this one runs. */
 JobResult runJob(
-	const BenchConfig& cfg, const Dataset& ds, const std::string& method, const std::string& out_dir,
-	std::optional<unsigned> seed, const std::function<void(double)>& progress = {});
+	const BenchConfig& cfg, const Dataset& ds, const std::string& method,
+	const std::string& out_dir, std::optional<unsigned> seed,
+	const std::function<void(double)>& progress = {});
 
 /** RPE of \a rows over \a interval_s; none when no pair matches. */
 std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, double interval_s);

@@ -31,7 +31,8 @@ std::string trim(const std::string& s)
 	return s.substr(a, s.find_last_not_of(" \t\r\n") - a + 1);
 }
 
-[[noreturn]] void fail(const std::string& file, const std::string& section, const std::string& key,
+[[noreturn]] void fail(
+	const std::string& file, const std::string& section, const std::string& key,
 	const std::string& what)
 {
 	std::string where = file;
@@ -41,8 +42,9 @@ std::string trim(const std::string& s)
 }
 
 // A positive finite number, the whole value consumed.
-double positiveNumber(const mrpt::config::CConfigFileBase& c, const std::string& file,
-	const std::string& section, const std::string& key, double fallback)
+double positiveNumber(
+	const mrpt::config::CConfigFileBase& c, const std::string& file, const std::string& section,
+	const std::string& key, double fallback)
 {
 	if (!c.keyExists(section, key)) return fallback;
 	const std::string v = trim(c.read_string(section, key, ""));
@@ -97,9 +99,11 @@ BenchConfig loadBenchConfig(const std::string& path)
 		c.getAllKeys(s, keys);
 		for (const auto& k : keys)
 			if (!(is_bench ? bench_keys : dataset_keys).count(k))
-				fail(path, s, k, is_bench ? "unknown key (expected methods, config_dir, data_dir, "
-											"min_span_px or rpe_interval_s)"
-										  : "unknown key (expected rawlog, map, gt or camera)");
+				fail(
+					path, s, k,
+					is_bench ? "unknown key (expected methods, config_dir, data_dir, "
+							   "min_span_px or rpe_interval_s)"
+							 : "unknown key (expected rawlog, map, gt or camera)");
 	}
 
 	if (c.sectionExists("bench"))
@@ -118,7 +122,8 @@ BenchConfig loadBenchConfig(const std::string& path)
 		if (c.keyExists("bench", "config_dir"))
 		{
 			const fs::path d = ini_dir / trim(c.read_string("bench", "config_dir", ""));
-			if (!fs::is_directory(d)) fail(path, "bench", "config_dir", d.string() + ": no such folder");
+			if (!fs::is_directory(d))
+				fail(path, "bench", "config_dir", d.string() + ": no such folder");
 			cfg.config_dir = fs::weakly_canonical(d).string();
 		}
 		if (c.keyExists("bench", "data_dir"))
@@ -130,8 +135,10 @@ BenchConfig loadBenchConfig(const std::string& path)
 	{
 		const std::string ekf = findShareFile("config/ekf.ini");
 		if (ekf.empty())
-			fail(path, "bench", "config_dir",
-				"not set, and share/codemark/config/ekf.ini was not found (set CODEMARK_SHARE_DIR)");
+			fail(
+				path, "bench", "config_dir",
+				"not set, and share/codemark/config/ekf.ini was not found (set "
+				"CODEMARK_SHARE_DIR)");
 		cfg.config_dir = fs::path(ekf).parent_path().string();
 	}
 	for (const auto& m : cfg.methods)
@@ -145,7 +152,8 @@ BenchConfig loadBenchConfig(const std::string& path)
 		d.name = trim(s.substr(8));
 		if (d.name.empty() || d.name.find_first_of("/\\ \t") != std::string::npos)
 			fail(path, s, "", "a dataset name must be non-empty, without spaces or slashes");
-		auto file = [&](const std::string& key, bool required) -> std::string {
+		auto file = [&](const std::string& key, bool required) -> std::string
+		{
 			const std::string v = trim(c.read_string(s, key, ""));
 			if (v.empty())
 			{

@@ -63,18 +63,21 @@ std::optional<filters::PoseEstimate> initialPose(const mrpt::config::CConfigFile
 	if (!cfg.read_bool("localize", "initial_pose_known", false)) return std::nullopt;
 	filters::PoseEstimate e;
 	e.initialized = true;
-	e.mean = CPose2D(cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
+	e.mean = CPose2D(
+		cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
 		mrpt::DEG2RAD(cfg.read_double("localize", "initial_yaw_deg", 0)));
 	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
 	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
 	if (!(sxy > 0) || !(syaw > 0))
-		throw std::invalid_argument("[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
+		throw std::invalid_argument(
+			"[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
 	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 	return e;
 }
 
 // Compares one frame's landmark observation with what the true pose shows.
-void tallyDetections(const CObservationCodedLandmarks& obs, const CPose2D& truth, const LandmarkMap& map,
+void tallyDetections(
+	const CObservationCodedLandmarks& obs, const CPose2D& truth, const LandmarkMap& map,
 	const std::optional<CameraModel>& camera_override, double min_span_px, DetectionStats& d)
 {
 	sim::Scene scene;
@@ -119,7 +122,7 @@ std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, 
 		if (j >= ok.size()) break;
 		const CPose2D rel_gt = *ok[j]->truth - *ok[i]->truth;
 		const CPose2D rel_est = ok[j]->estimate.mean - ok[i]->estimate.mean;
-		const CPose2D e = rel_est - rel_gt;  // rel_gt^-1 (+) rel_est
+		const CPose2D e = rel_est - rel_gt;	 // rel_gt^-1 (+) rel_est
 		st += e.x() * e.x() + e.y() * e.y();
 		sy += mrpt::math::wrapToPi(e.phi()) * mrpt::math::wrapToPi(e.phi());
 		++rpe.pairs;
@@ -165,8 +168,10 @@ std::optional<Alignment> alignPath(const std::vector<filters::PathRow>& rows)
 	return a;
 }
 
-JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& method, const std::string& out_dir,
-	std::optional<unsigned> seed, const std::function<void(double)>& progress)
+JobResult runJob(
+	const BenchConfig& cfg, const Dataset& ds, const std::string& method,
+	const std::string& out_dir, std::optional<unsigned> seed,
+	const std::function<void(double)>& progress)
 {
 	JobResult r;
 	r.dataset = ds.name;
@@ -181,7 +186,8 @@ JobResult runJob(const BenchConfig& cfg, const Dataset& ds, const std::string& m
 		auto& s = r.summary;
 		s.method = method;
 		const bool mrpt_map = filters::isMrptLandmarksFile(ds.map);
-		const LandmarkMap map = mrpt_map ? filters::loadMrptLandmarksFile(ds.map) : LandmarkMap::load(ds.map);
+		const LandmarkMap map =
+			mrpt_map ? filters::loadMrptLandmarksFile(ds.map) : LandmarkMap::load(ds.map);
 		const filters::GroundTruth gt = filters::GroundTruth::load(ds.gt);
 		std::optional<CameraModel> camera;
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);

@@ -36,24 +36,30 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"Benchmarks codemark's localization over a list of datasets (a rawlog with camera images "
-			"or with codemark landmark observations, a landmark map, a ground-truth path, optionally "
+			"Benchmarks codemark's localization over a list of datasets (a rawlog with camera "
+			"images "
+			"or with codemark landmark observations, a landmark map, a ground-truth path, "
+			"optionally "
 			"a camera file), listed in an ini (share/codemark/bench.ini documents the keys), and a "
-			"set of methods (ekf, ekf-pose, ekf-slam, pf; their inis come from [bench] config_dir). "
+			"set of methods (ekf, ekf-pose, ekf-slam, pf; their inis come from [bench] "
+			"config_dir). "
 			"One job per dataset x method runs on a pool of threads. Writes into --out DIR: "
 			"results.csv (one row per job), report.md (tables, definitions, plots), "
 			"<dataset>-error.png (position error against time with the filter's 3-sigma bound), "
 			"<dataset>-trajectories.png (estimates, ground truth, landmarks), and each job's "
 			"codemark-localize outputs in <dataset>/<method>/. Exits non-zero if any job failed.",
 			' ', "0.1");
-		TCLAP::ValueArg<std::string> config("c", "config", "the benchmark ini", true, "", "BENCH.ini", cmd);
+		TCLAP::ValueArg<std::string> config(
+			"c", "config", "the benchmark ini", true, "", "BENCH.ini", cmd);
 		TCLAP::ValueArg<std::string> out(
-			"o", "out", "output directory, created (default: bench-out)", false, "bench-out", "DIR", cmd);
+			"o", "out", "output directory, created (default: bench-out)", false, "bench-out", "DIR",
+			cmd);
 		TCLAP::ValueArg<unsigned> jobs(
 			"j", "jobs", "parallel jobs (default: the hardware concurrency)", false, 0, "N", cmd);
-		TCLAP::ValueArg<std::string> methods("m", "methods",
-			"comma-separated methods, overriding [bench] methods (ekf,ekf-pose,ekf-slam,pf)", false, "",
-			"LIST", cmd);
+		TCLAP::ValueArg<std::string> methods(
+			"m", "methods",
+			"comma-separated methods, overriding [bench] methods (ekf,ekf-pose,ekf-slam,pf)", false,
+			"", "LIST", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
@@ -62,11 +68,13 @@ int main(int argc, char** argv)
 		if (methods.isSet()) cfg.methods = parseMethods(methods.getValue(), "--methods");
 		for (const auto& m : cfg.methods)
 			if (!std::ifstream(cfg.config_dir + "/" + m + ".ini").good())
-				throw std::runtime_error(cfg.config_dir + "/" + m + ".ini: cannot open (method " + m + ")");
+				throw std::runtime_error(
+					cfg.config_dir + "/" + m + ".ini: cannot open (method " + m + ")");
 		const std::string dir = out.getValue();
 		std::error_code ec;
 		fs::create_directories(dir, ec);
-		if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": cannot create the output directory");
+		if (!fs::is_directory(dir))
+			throw std::runtime_error(dir + ": cannot create the output directory");
 
 		struct Job
 		{
@@ -77,8 +85,8 @@ int main(int argc, char** argv)
 		for (const auto& d : cfg.datasets)
 			for (const auto& m : cfg.methods) todo.push_back({&d, m});
 		const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-		const int nthreads =
-			static_cast<int>(std::min<std::size_t>(jobs.getValue() ? jobs.getValue() : hw, todo.size()));
+		const int nthreads = static_cast<int>(
+			std::min<std::size_t>(jobs.getValue() ? jobs.getValue() : hw, todo.size()));
 
 		std::vector<JobResult> results(todo.size());
 		std::vector<double> fraction(todo.size(), 0.0);
@@ -100,7 +108,8 @@ int main(int argc, char** argv)
 		int running = 0;  // jobs running
 		std::mutex queue_mutex;
 		std::condition_variable queue_cv;
-		auto take = [&]() -> std::optional<std::size_t> {
+		auto take = [&]() -> std::optional<std::size_t>
+		{
 			std::unique_lock<std::mutex> lock(queue_mutex);
 			while (true)
 			{
@@ -120,21 +129,27 @@ int main(int argc, char** argv)
 				queue_cv.wait(lock);
 			}
 		};
-		auto release = [&](std::size_t k) {
+		auto release = [&](std::size_t k)
+		{
 			std::lock_guard<std::mutex> lock(queue_mutex);
 			if (drawsRandom(todo[k].method)) random_busy = false;
 			--running;
 			queue_cv.notify_all();
 		};
 		const auto t0 = std::chrono::steady_clock::now();
-		auto worker = [&] {
+		auto worker = [&]
+		{
 			while (const auto next = take())
 			{
 				const std::size_t k = *next;
 				const auto& j = todo[k];
-				results[k] = runJob(cfg, *j.ds, j.method, dir + "/" + j.ds->name + "/" + j.method,
-					drawsRandom(j.method) ? std::optional<unsigned>(seedOf(j.ds->name + "/" + j.method)) : std::nullopt,
-					[&, k](double f) {
+				results[k] = runJob(
+					cfg, *j.ds, j.method, dir + "/" + j.ds->name + "/" + j.method,
+					drawsRandom(j.method)
+						? std::optional<unsigned>(seedOf(j.ds->name + "/" + j.method))
+						: std::nullopt,
+					[&, k](double f)
+					{
 						std::lock_guard<std::mutex> lock(mutex);
 						fraction[k] = f;
 						double sum = 0;
@@ -151,7 +166,8 @@ int main(int argc, char** argv)
 		for (int i = 0; i < nthreads; ++i) pool.emplace_back(worker);
 		for (auto& t : pool) t.join();
 		bar.finish();
-		const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+		const double wall =
+			std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
 		std::vector<std::pair<std::string, std::vector<std::string>>> plots;
 		for (const auto& d : cfg.datasets)
@@ -173,11 +189,13 @@ int main(int argc, char** argv)
 			if (!r.ok)
 			{
 				++failed;
-				std::cerr << "codemark-bench: " << r.dataset << " / " << r.method << ": " << r.error << "\n";
+				std::cerr << "codemark-bench: " << r.dataset << " / " << r.method << ": " << r.error
+						  << "\n";
 			}
-		std::cout << "codemark-bench: " << results.size() << " jobs (" << cfg.datasets.size() << " datasets x "
-				  << cfg.methods.size() << " methods) on " << nthreads << " threads in " << wall << " s, "
-				  << failed << " failed; wrote " << dir << "/report.md and results.csv\n";
+		std::cout << "codemark-bench: " << results.size() << " jobs (" << cfg.datasets.size()
+				  << " datasets x " << cfg.methods.size() << " methods) on " << nthreads
+				  << " threads in " << wall << " s, " << failed << " failed; wrote " << dir
+				  << "/report.md and results.csv\n";
 		return failed ? 1 : 0;
 	}
 	catch (const TCLAP::ExitException& e)
@@ -188,7 +206,8 @@ int main(int argc, char** argv)
 	{
 		const std::string id = e.argId();
 		const bool named = id.find_first_not_of(' ') != std::string::npos;
-		std::cerr << "codemark-bench: " << (named ? id + ": " : "") << e.error() << " (see --help)\n";
+		std::cerr << "codemark-bench: " << (named ? id + ": " : "") << e.error()
+				  << " (see --help)\n";
 	}
 	catch (const std::exception& e)
 	{

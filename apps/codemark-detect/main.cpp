@@ -30,13 +30,17 @@ using namespace codemark;
 
 namespace
 {
-const std::vector<std::string> kImageExt = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"};
-const std::vector<std::string> kVideoExt = {".mp4", ".avi", ".mkv", ".mov", ".webm", ".mpg", ".mpeg", ".m4v"};
+const std::vector<std::string> kImageExt = {".png",	 ".jpg", ".jpeg", ".bmp", ".tif",
+											".tiff", ".pgm", ".ppm",  ".webp"};
+const std::vector<std::string> kVideoExt = {".mp4",	 ".avi", ".mkv",  ".mov",
+											".webm", ".mpg", ".mpeg", ".m4v"};
 
 std::string lowerExt(const fs::path& p)
 {
 	std::string e = p.extension().string();
-	std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+	std::transform(
+		e.begin(), e.end(), e.begin(),
+		[](unsigned char c) { return static_cast<char>(std::tolower(c)); });
 	return e;
 }
 
@@ -58,13 +62,13 @@ std::string flatName(const std::string& s)
 std::string jsonVector(const Eigen::Vector3d& v)
 {
 	return "[" + detect::jsonNumber(v[0]) + ", " + detect::jsonNumber(v[1]) + ", " +
-		detect::jsonNumber(v[2]) + "]";
+		   detect::jsonNumber(v[2]) + "]";
 }
 
 std::string jsonMatrix(const Eigen::Matrix3d& m)
 {
 	return "[" + jsonVector(m.row(0).transpose()) + ", " + jsonVector(m.row(1).transpose()) + ", " +
-		jsonVector(m.row(2).transpose()) + "]";
+		   jsonVector(m.row(2).transpose()) + "]";
 }
 
 struct Runner
@@ -96,10 +100,11 @@ struct Runner
 		// at: another size would give a silently wrong P, L and pose.
 		if (img.cols != camera.width() || img.rows != camera.height())
 		{
-			fail(name, "image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-						   " but the camera is " + std::to_string(camera.width()) + "x" +
-						   std::to_string(camera.height()) +
-						   ": pass --camera with this image's calibration");
+			fail(
+				name, "image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+						  " but the camera is " + std::to_string(camera.width()) + "x" +
+						  std::to_string(camera.height()) +
+						  ": pass --camera with this image's calibration");
 			return;
 		}
 		std::string dbg;
@@ -140,7 +145,8 @@ struct Runner
 			extra.push_back(std::move(f));
 		}
 		std::cout << detect::imageToJson(
-						 name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks, extra)
+						 name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks,
+						 extra)
 				  << std::endl;
 		if (!draw_dir.empty())
 		{
@@ -172,8 +178,9 @@ struct Runner
 		// segments the green fill in 8-bit colour.
 		if (img.depth() != CV_8U)
 		{
-			fail(path, "the image has " + std::to_string(8 * img.elemSize1()) +
-						   "-bit samples; codemark needs 8-bit colour images");
+			fail(
+				path, "the image has " + std::to_string(8 * img.elemSize1()) +
+						  "-bit samples; codemark needs 8-bit colour images");
 			return;
 		}
 		if (img.channels() == 1)
@@ -234,36 +241,47 @@ int main(int argc, char** argv)
 		TCLAP::CmdLine cmd(
 			"Detects coded landmarks (landmark-spec.md) in images with the detector of Baczyk, "
 			"Kasinski and Skrzypczynski (2003) and prints one JSON object per image on its own "
-			"line (spec section 5): {\"image\", \"width\", \"height\", \"time_ms\", \"detections\": "
-			"[{\"id\", \"corners\" (inner frame corners in raw pixels, TL TR BR BL as they appear in "
-			"the image, pixel (0,0) at the centre of the top-left pixel), \"P\" ([x1 y1 x2 y2] from "
+			"line (spec section 5): {\"image\", \"width\", \"height\", \"time_ms\", "
+			"\"detections\": "
+			"[{\"id\", \"corners\" (inner frame corners in raw pixels, TL TR BR BL as they appear "
+			"in "
+			"the image, pixel (0,0) at the centre of the top-left pixel), \"P\" ([x1 y1 x2 y2] "
+			"from "
 			"the undistorted corners)}]}. time_ms is the detector's own time, without file "
 			"decoding. An input that cannot be read gives {\"image\", \"error\"} and the run goes "
 			"on; the exit code is 1 at the end if any input failed.",
 			' ', "0.1.0");
-		TCLAP::ValueArg<std::string> camera_arg("", "camera",
-			"Camera intrinsics: MRPT [CAMERA_PARAMS] ini (.ini/.cfg/.txt, e.g. from camera-calib) or "
+		TCLAP::ValueArg<std::string> camera_arg(
+			"", "camera",
+			"Camera intrinsics: MRPT [CAMERA_PARAMS] ini (.ini/.cfg/.txt, e.g. from camera-calib) "
+			"or "
 			"ROS/OpenCV calibration YAML (.yaml/.yml). Distortion is taken into account for the "
 			"line fits and P. Default: share/codemark/camera-paper.ini (640x480, fx = fy = 800).",
 			false, "", "CAM", cmd);
-		TCLAP::ValueArg<std::string> landmark_arg("", "landmark",
+		TCLAP::ValueArg<std::string> landmark_arg(
+			"", "landmark",
 			"Landmark sizes: ini file with a [LANDMARK] section (share/codemark/landmark.ini). "
 			"Only the proportions matter to the detector. Default: the spec's A4 landmark.",
 			false, "", "LM.ini", cmd);
-		TCLAP::ValueArg<std::string> config_arg("", "config",
+		TCLAP::ValueArg<std::string> config_arg(
+			"", "config",
 			"Detector parameters: ini file with a [DETECTOR] section (share/codemark/detector.ini "
 			"lists every parameter with its default and unit), and optionally a [pose] section "
-			"(method = ClosedForm|General6Dof, sigma_px, sigma_y_px). Default: the built-in defaults.",
+			"(method = ClosedForm|General6Dof, sigma_px, sigma_y_px). Default: the built-in "
+			"defaults.",
 			false, "", "detector.ini", cmd);
-		TCLAP::ValueArg<std::string> draw_arg("", "draw",
+		TCLAP::ValueArg<std::string> draw_arg(
+			"", "draw",
 			"Folder (created when missing) that receives one overlay PNG per image: the "
 			"detected frame, corners (top-left marked), ID and the landmark's axes.",
 			false, "", "DIR", cmd);
-		TCLAP::ValueArg<std::string> debug_arg("", "debug-dir",
+		TCLAP::ValueArg<std::string> debug_arg(
+			"", "debug-dir",
 			"Folder (created when missing) that receives per image a sub-folder with the "
 			"detector's stage images: colour mask, components, edgels, fitted lines, overlay.",
 			false, "", "DIR", cmd);
-		TCLAP::UnlabeledMultiArg<std::string> inputs_arg("inputs",
+		TCLAP::UnlabeledMultiArg<std::string> inputs_arg(
+			"inputs",
 			"Image files, folders (every image inside, sorted by name; not recursive) or video "
 			"files (.mp4, .avi, .mkv, ...; frames named VIDEO#N, N from 0).",
 			true, "INPUT", cmd);
@@ -275,13 +293,16 @@ int main(int argc, char** argv)
 		// Single-threaded: time_ms is the detector's own, comparable figure.
 		cv::setNumThreads(1);
 		Runner r;
-		r.camera = camera_arg.isSet() ? CameraModel::load(camera_arg.getValue()) : CameraModel::paperDefault();
+		r.camera = camera_arg.isSet() ? CameraModel::load(camera_arg.getValue())
+									  : CameraModel::paperDefault();
 		if (landmark_arg.isSet())
 		{
 			const std::string& path = landmark_arg.getValue();
-			if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot open the landmark file");
+			if (!std::ifstream(path).good())
+				throw std::runtime_error(path + ": cannot open the landmark file");
 			mrpt::config::CConfigFile cfg(path);
-			if (!cfg.sectionExists("LANDMARK")) throw std::runtime_error(path + ": no [LANDMARK] section");
+			if (!cfg.sectionExists("LANDMARK"))
+				throw std::runtime_error(path + ": no [LANDMARK] section");
 			try
 			{
 				r.geometry.loadFromConfigFile(cfg, "LANDMARK");

@@ -33,14 +33,16 @@ LiveView::LiveView(int every_n_steps, const std::optional<filters::GroundTruth>&
 	requireDisplay();
 	impl_->win = mrpt::gui::CDisplayWindow3D::Create("codemark-localize", 800, 600);
 	if (!impl_->win->isOpen())
-		throw std::runtime_error("--gui: the 3D window could not be opened (see the messages above)");
+		throw std::runtime_error(
+			"--gui: the 3D window could not be opened (see the messages above)");
 	impl_->win->setCameraElevationDeg(90.0f);
 	impl_->win->setCameraAzimuthDeg(-90.0f);
 }
 
 LiveView::~LiveView() = default;
 
-void LiveView::update(const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f)
+void LiveView::update(
+	const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f)
 {
 	if (s.steps % every_n_ != 0) return;
 	std::vector<filters::MappedLandmark> lms = f.landmarks();
@@ -66,12 +68,15 @@ void LiveView::finish(const filters::LocalizeSummary& s, const LandmarkMap& map,
 	}
 }
 
-void LiveView::draw(const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks)
+void LiveView::draw(
+	const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks)
 {
 	if (!impl_->win || !impl_->win->isOpen()) return;  // closed by the user: the run goes on
 	double xmin = 1e9, xmax = -1e9, ymin = 1e9, ymax = -1e9;
-	auto extend = [&](double x, double y) {
-		xmin = std::min(xmin, x), xmax = std::max(xmax, x), ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+	auto extend = [&](double x, double y)
+	{
+		xmin = std::min(xmin, x), xmax = std::max(xmax, x), ymin = std::min(ymin, y),
+		ymax = std::max(ymax, y);
 	};
 	{
 		auto& scene = impl_->win->get3DSceneAndLock();
@@ -100,7 +105,8 @@ void LiveView::draw(const filters::LocalizeSummary& s, const std::vector<filters
 		{
 			if (!r.estimate.initialized) continue;
 			if (last)
-				est->appendLine(last->estimate.mean.x(), last->estimate.mean.y(), 0.02, r.estimate.mean.x(),
+				est->appendLine(
+					last->estimate.mean.x(), last->estimate.mean.y(), 0.02, r.estimate.mean.x(),
 					r.estimate.mean.y(), 0.02);
 			last = &r;
 			extend(r.estimate.mean.x(), r.estimate.mean.y());
@@ -127,7 +133,7 @@ void LiveView::draw(const filters::LocalizeSummary& s, const std::vector<filters
 			mrpt::math::CMatrixDouble22 C;
 			C.asEigen() = e.cov.block<2, 2>(0, 0);
 			ell->setCovMatrix(C);
-			ell->setQuantiles(std::sqrt(mrpt::math::chi2inv(0.95, 2)));  // 95% in 2 DoF
+			ell->setQuantiles(std::sqrt(mrpt::math::chi2inv(0.95, 2)));	 // 95% in 2 DoF
 			ell->setColor_u8(255, 0, 0);
 			ell->setLineWidth(2);
 			ell->setLocation(e.mean.x(), e.mean.y(), 0.04);
@@ -140,11 +146,15 @@ void LiveView::draw(const filters::LocalizeSummary& s, const std::vector<filters
 		// Frame the ground truth and map once (the view then stays put).
 		impl_->win->setCameraPointingToPoint(
 			static_cast<float>(0.5 * (xmin + xmax)), static_cast<float>(0.5 * (ymin + ymax)), 0.0f);
-		impl_->win->setCameraZoom(static_cast<float>(2.4 * std::max({xmax - xmin, ymax - ymin, 2.0})));
+		impl_->win->setCameraZoom(
+			static_cast<float>(2.4 * std::max({xmax - xmin, ymax - ymin, 2.0})));
 		impl_->camera_set = gt_ || !landmarks.empty();
 	}
-	impl_->win->addTextMessage(0.02, 0.95,
-		"step " + std::to_string(s.steps) + "  blue: estimate  green: truth  red: landmarks, 95% ellipse", 0);
+	impl_->win->addTextMessage(
+		0.02, 0.95,
+		"step " + std::to_string(s.steps) +
+			"  blue: estimate  green: truth  red: landmarks, 95% ellipse",
+		0);
 	impl_->win->forceRepaint();
 }
 

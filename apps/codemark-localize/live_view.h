@@ -23,14 +23,16 @@ class LiveView
 	~LiveView();
 
 	/** The StepObserver of runLocalization: redraws every N steps. */
-	void update(const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f);
+	void update(
+		const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f);
 
 	/** Draws the final state; with \a wait_for_key, waits for a key press in
 	 * the window (or its closing) before returning. */
 	void finish(const filters::LocalizeSummary& s, const LandmarkMap& map, bool wait_for_key);
 
    private:
-	void draw(const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks);
+	void draw(
+		const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks);
 
 	struct Impl;
 	std::unique_ptr<Impl> impl_;

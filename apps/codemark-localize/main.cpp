@@ -38,7 +38,8 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"Localizes a robot (or builds a map with ekf-slam) from a rawlog of either MRPT format: "
+			"Localizes a robot (or builds a map with ekf-slam) from a rawlog of either MRPT "
+			"format: "
 			"camera images (detected on the fly with the camera stored in each image observation), "
 			"codemark landmark observations, or CObservationBearingRange, fused with the odometry "
 			"(CActionRobotMovement2D, or CObservationOdometry interpolated to each image's time). "
@@ -48,26 +49,43 @@ int main(int argc, char** argv)
 			"trajectory.3Dscene (SceneViewer3D) and summary.json. Configuration: "
 			"share/codemark/config/<method>.ini.",
 			' ', "0.1");
-		TCLAP::ValueArg<std::string> config("c", "config", "the method's ini file", true, "", "CFG.ini", cmd);
-		TCLAP::ValueArg<std::string> rawlog("r", "rawlog", "input rawlog", true, "", "IN.rawlog", cmd);
-		TCLAP::ValueArg<std::string> map("m", "map",
+		TCLAP::ValueArg<std::string> config(
+			"c", "config", "the method's ini file", true, "", "CFG.ini", cmd);
+		TCLAP::ValueArg<std::string> rawlog(
+			"r", "rawlog", "input rawlog", true, "", "IN.rawlog", cmd);
+		TCLAP::ValueArg<std::string> map(
+			"m", "map",
 			"landmark map (spec section 3) or MRPT landmark ground truth (x y z type 0 0 id); "
-			"required except for ekf-slam", false, "", "MAP.txt", cmd);
-		TCLAP::ValueArg<std::string> method("", "method",
-			"ekf | ekf-pose | ekf-slam | pf (default: the ini's [localize] method, else ekf)", false, "",
-			"NAME", cmd);
-		TCLAP::ValueArg<std::string> gt("g", "gt",
+			"required except for ekf-slam",
+			false, "", "MAP.txt", cmd);
+		TCLAP::ValueArg<std::string> method(
+			"", "method",
+			"ekf | ekf-pose | ekf-slam | pf (default: the ini's [localize] method, else ekf)",
+			false, "", "NAME", cmd);
+		TCLAP::ValueArg<std::string> gt(
+			"g", "gt",
 			"ground truth: 'timestamp x y yaw' rows (matched by timestamp) or an MRPT robot path "
-			"'x y z yaw pitch roll' (row 0 = the start pose; in actions-observations rawlogs a frame matches the row of the number of actions before it, kf-slam's step i row i + 1; else step i = row i + 1)", false, "", "GT.txt", cmd);
-		TCLAP::ValueArg<std::string> gt_map("", "gt-map",
+			"'x y z yaw pitch roll' (row 0 = the start pose; in actions-observations rawlogs a "
+			"frame matches the row of the number of actions before it, kf-slam's step i row i + 1; "
+			"else step i = row i + 1)",
+			false, "", "GT.txt", cmd);
+		TCLAP::ValueArg<std::string> gt_map(
+			"", "gt-map",
 			"ekf-slam: the true landmark map (spec section 3 or MRPT's x y z type 0 0 id) for the "
-			"landmark RMSE in summary.json", false, "", "MAP.txt", cmd);
-		TCLAP::ValueArg<std::string> out("o", "out", "output directory (created)", true, "", "DIR", cmd);
-		TCLAP::SwitchArg gui("", "gui",
-			"live 3D view while running (estimate, ground truth, landmarks, current pose with its 95% ellipse); "
-			"needs an X display (e.g. xvfb-run -a)", cmd);
-		TCLAP::ValueArg<int> gui_every("", "gui-every", "--gui: redraw every N steps (default 10)", false, 10, "N", cmd);
-		TCLAP::SwitchArg gui_wait("", "gui-wait", "--gui: at the end, wait for a key in the window", cmd);
+			"landmark RMSE in summary.json",
+			false, "", "MAP.txt", cmd);
+		TCLAP::ValueArg<std::string> out(
+			"o", "out", "output directory (created)", true, "", "DIR", cmd);
+		TCLAP::SwitchArg gui(
+			"", "gui",
+			"live 3D view while running (estimate, ground truth, landmarks, current pose with its "
+			"95% ellipse); "
+			"needs an X display (e.g. xvfb-run -a)",
+			cmd);
+		TCLAP::ValueArg<int> gui_every(
+			"", "gui-every", "--gui: redraw every N steps (default 10)", false, 10, "N", cmd);
+		TCLAP::SwitchArg gui_wait(
+			"", "gui-wait", "--gui: at the end, wait for a key in the window", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
@@ -91,15 +109,17 @@ int main(int argc, char** argv)
 		}
 		codemark::filters::StepObserver on_step;
 		if (view)
-			on_step = [&](const codemark::filters::LocalizeSummary& so_far, const codemark::LandmarkMap& m,
-						  const codemark::filters::Localizer& f) { view->update(so_far, m, f); };
+			on_step = [&](const codemark::filters::LocalizeSummary& so_far,
+						  const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
+			{ view->update(so_far, m, f); };
 		codemark::app::ProgressBar bar("codemark-localize", !quiet.getValue());
 		codemark::LandmarkMap used_map;
 		const auto s = codemark::filters::runLocalization(
 			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); },
 			view ? codemark::filters::StepObserver(
-					   [&](const codemark::filters::LocalizeSummary& so_far, const codemark::LandmarkMap& m,
-						   const codemark::filters::Localizer& f) {
+					   [&](const codemark::filters::LocalizeSummary& so_far,
+						   const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
+					   {
 						   used_map = m;
 						   on_step(so_far, m, f);
 					   })
@@ -108,7 +128,8 @@ int main(int argc, char** argv)
 		if (s.steps == 0)
 			throw std::runtime_error(
 				req.rawlog +
-				": no camera frame to localize from (no CObservationImage, CObservationCodedLandmarks "
+				": no camera frame to localize from (no CObservationImage, "
+				"CObservationCodedLandmarks "
 				"or CObservationBearingRange in the rawlog)");
 		if (view)
 		{
@@ -116,13 +137,15 @@ int main(int argc, char** argv)
 			if (gui_wait.getValue()) view->finish(s, used_map, true);
 		}
 		std::cout << "codemark-localize: " << s.method << ", " << s.steps << " steps, "
-				  << s.sightings_used << " sightings used, " << s.sightings_rejected << " rejected, "
-				  << s.sightings_unknown_id << " unknown IDs, " << s.time_per_step_ms << " ms/step";
+				  << s.sightings_used << " sightings used, " << s.sightings_rejected
+				  << " rejected, " << s.sightings_unknown_id << " unknown IDs, "
+				  << s.time_per_step_ms << " ms/step";
 		if (s.metrics)
-			std::cout << "; ATE " << s.metrics->ate_rmse_m << " m, yaw RMSE " << s.metrics->yaw_rmse_deg
-					  << " deg, mean NEES " << s.metrics->nees_mean
+			std::cout << "; ATE " << s.metrics->ate_rmse_m << " m, yaw RMSE "
+					  << s.metrics->yaw_rmse_deg << " deg, mean NEES " << s.metrics->nees_mean
 					  << (s.metrics->aligned ? " (SE(2)-aligned to the ground truth; " +
-								std::to_string(s.metrics->ate_rmse_anchored_m) + " m anchored at the true start)"
+												   std::to_string(s.metrics->ate_rmse_anchored_m) +
+												   " m anchored at the true start)"
 											 : std::string());
 		std::cout << "; wrote " << req.out_dir << "\n";
 		return 0;

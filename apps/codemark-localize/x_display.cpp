@@ -17,7 +17,8 @@ void requireDisplay()
 	Display* x = XOpenDisplay(nullptr);
 	if (!x)
 		throw std::runtime_error(
-			std::string("--gui: cannot open display '") + d + "'; run without --gui, or under xvfb-run -a");
+			std::string("--gui: cannot open display '") + d +
+			"'; run without --gui, or under xvfb-run -a");
 	XCloseDisplay(x);
 }
 }  // namespace codemark::app

@@ -43,14 +43,18 @@ int main(int argc, char** argv)
 			"Renders camera frames of the landmarks of a map with exact ground truth. Writes into "
 			"--out DIR: frame_000.png, frame_001.png, ...; truth.jsonl (one JSON object per frame: "
 			"image, width, height, camera_pose [x y z yaw pitch roll] of the camera body frame "
-			"(x forward, y left, z up; m, rad), and for every landmark in view: id, corners (the four "
-			"inner frame corners in raw pixels, TL TR BR BL), P, L, pose_in_landmark, fully_visible, "
+			"(x forward, y left, z up; m, rad), and for every landmark in view: id, corners (the "
+			"four "
+			"inner frame corners in raw pixels, TL TR BR BL), P, L, pose_in_landmark, "
+			"fully_visible, "
 			"area_px, occluded_fraction); camera.ini (the camera used, MRPT [CAMERA_PARAMS]); "
 			"render.ini (the render options used, section [RENDER]). Deterministic for a seed.",
 			' ', "0.1");
 		TCLAP::ValueArg<std::string> mapArg(
-			"m", "map", "landmark map file ('id x y z yaw_deg [scale]' per line)", true, "", "MAP.txt", cmd);
-		TCLAP::ValueArg<std::string> outArg("o", "out", "output directory (created if missing)", true, "", "DIR", cmd);
+			"m", "map", "landmark map file ('id x y z yaw_deg [scale]' per line)", true, "",
+			"MAP.txt", cmd);
+		TCLAP::ValueArg<std::string> outArg(
+			"o", "out", "output directory (created if missing)", true, "", "DIR", cmd);
 		TCLAP::ValueArg<std::string> cameraArg(
 			"c", "camera",
 			"camera file: MRPT [CAMERA_PARAMS] .ini or ROS/OpenCV calibration .yaml; default: the "
@@ -63,44 +67,54 @@ int main(int argc, char** argv)
 			"poses that look at the map's landmarks in turn",
 			false, "", "POSES.txt", cmd);
 		TCLAP::ValueArg<int> framesArg(
-			"n", "frames", "number of generated poses without --poses (default 8)", false, 8, "N", cmd);
+			"n", "frames", "number of generated poses without --poses (default 8)", false, 8, "N",
+			cmd);
 		TCLAP::ValueArg<uint64_t> seedArg(
-			"s", "seed", "seed of the generated poses and of the renderer's randomness (default 1)", false, 1,
-			"S", cmd);
+			"s", "seed", "seed of the generated poses and of the renderer's randomness (default 1)",
+			false, 1, "S", cmd);
 		TCLAP::ValueArg<std::string> optionsArg(
 			"", "options",
 			"render options ini (keys of codemark::sim::RenderOptions: background = Flat|Textured|"
-			"Cluttered, distractors, noise_sigma, blur_sigma_px, motion_blur_px, jpeg_quality, gain, "
-			"gradient, occlusion, ...). Keys not given keep the demo defaults: Cluttered (texture with "
+			"Cluttered, distractors, noise_sigma, blur_sigma_px, motion_blur_px, jpeg_quality, "
+			"gain, "
+			"gradient, occlusion, ...). Keys not given keep the demo defaults: Cluttered (texture "
+			"with "
 			"6 distractors), noise_sigma 2, blur_sigma_px 0.8",
 			false, "", "RENDER.ini", cmd);
 		TCLAP::ValueArg<std::string> sectionArg(
-			"", "section", "section of --options to read (default RENDER)", false, "RENDER", "NAME", cmd);
+			"", "section", "section of --options to read (default RENDER)", false, "RENDER", "NAME",
+			cmd);
 		TCLAP::ValueArg<double> minDistArg(
-			"", "min-distance", "generated poses: least horizontal distance to the landmark [m] (default 0.8)",
-			false, 0.8, "M", cmd);
+			"", "min-distance",
+			"generated poses: least horizontal distance to the landmark [m] (default 0.8)", false,
+			0.8, "M", cmd);
 		TCLAP::ValueArg<double> maxDistArg(
-			"", "max-distance", "generated poses: greatest horizontal distance [m] (default 4)", false, 4.0,
-			"M", cmd);
+			"", "max-distance", "generated poses: greatest horizontal distance [m] (default 4)",
+			false, 4.0, "M", cmd);
 		TCLAP::ValueArg<double> maxAngleArg(
-			"", "max-angle", "generated poses: greatest view angle from the landmark's normal [deg] (default 50)",
+			"", "max-angle",
+			"generated poses: greatest view angle from the landmark's normal [deg] (default 50)",
 			false, 50.0, "DEG", cmd);
 		TCLAP::ValueArg<double> heightArg(
-			"", "height", "generated poses: camera height in the world [m] (default 0.6)", false, 0.6, "M", cmd);
+			"", "height", "generated poses: camera height in the world [m] (default 0.6)", false,
+			0.6, "M", cmd);
 		TCLAP::SwitchArg quietArg("q", "quiet", "no progress indication on stderr", cmd);
 		cmd.parse(argc, argv);
 
 		const LandmarkMap map = LandmarkMap::load(mapArg.getValue());
-		if (map.landmarks.empty()) throw std::runtime_error(mapArg.getValue() + ": the map has no landmarks");
+		if (map.landmarks.empty())
+			throw std::runtime_error(mapArg.getValue() + ": the map has no landmarks");
 		CameraModel camera;
 		try
 		{
-			camera = cameraArg.isSet() ? CameraModel::load(cameraArg.getValue()) : CameraModel::paperDefault();
+			camera = cameraArg.isSet() ? CameraModel::load(cameraArg.getValue())
+									   : CameraModel::paperDefault();
 		}
 		catch (const std::exception& e)
 		{
 			const std::string msg = oneLine(e.what());
-			const std::string file = cameraArg.isSet() ? cameraArg.getValue() : "the default camera";
+			const std::string file =
+				cameraArg.isSet() ? cameraArg.getValue() : "the default camera";
 			throw std::runtime_error(msg.find(file) == std::string::npos ? file + ": " + msg : msg);
 		}
 
@@ -108,7 +122,8 @@ int main(int argc, char** argv)
 		if (optionsArg.isSet())
 		{
 			if (!std::ifstream(optionsArg.getValue()).good())
-				throw std::runtime_error(optionsArg.getValue() + ": cannot open render options file");
+				throw std::runtime_error(
+					optionsArg.getValue() + ": cannot open render options file");
 			mrpt::config::CConfigFile cfg(optionsArg.getValue());
 			try
 			{
@@ -131,7 +146,8 @@ int main(int argc, char** argv)
 			vp.max_distance_m = maxDistArg.getValue();
 			vp.max_view_angle_rad = maxAngleArg.getValue() * M_PI / 180;
 			vp.camera_height_m = heightArg.getValue();
-			poses = sim::viewpointsAroundLandmarks(map, framesArg.getValue(), seedArg.getValue(), vp);
+			poses =
+				sim::viewpointsAroundLandmarks(map, framesArg.getValue(), seedArg.getValue(), vp);
 		}
 
 		const fs::path out(outArg.getValue());
@@ -166,14 +182,17 @@ int main(int argc, char** argv)
 			bar.update(static_cast<long>(i + 1), static_cast<long>(poses.size()));
 		}
 		bar.finish();
-		if (!truth.flush()) throw std::runtime_error((out / "truth.jsonl").string() + ": cannot write");
+		if (!truth.flush())
+			throw std::runtime_error((out / "truth.jsonl").string() + ": cannot write");
 		std::cout << "codemark-render: " << poses.size() << " frames, " << in_view
-				  << " landmark sightings in view; wrote " << out.string() << "/{frame_*.png,truth.jsonl,camera.ini,render.ini}\n";
+				  << " landmark sightings in view; wrote " << out.string()
+				  << "/{frame_*.png,truth.jsonl,camera.ini,render.ini}\n";
 		return 0;
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-render: error: " << e.error() << " (argument " << e.argId() << "); see --help\n";
+		std::cerr << "codemark-render: error: " << e.error() << " (argument " << e.argId()
+				  << "); see --help\n";
 		return 1;
 	}
 	catch (const std::exception& e)

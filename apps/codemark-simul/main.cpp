@@ -18,21 +18,27 @@ int main(int argc, char** argv)
 	{
 		TCLAP::CmdLine cmd(
 			"Writes a simulated dataset for codemark: a map (from a file, or a generated room with "
-			"landmarks on its walls), a trajectory (from a file, or a generated loop), noisy odometry "
-			"from MRPT's motion models, and rendered camera images with exact ground truth. Output in "
+			"landmarks on its walls), a trajectory (from a file, or a generated loop), noisy "
+			"odometry "
+			"from MRPT's motion models, and rendered camera images with exact ground truth. Output "
+			"in "
 			"--out DIR: dataset.rawlog (MRPT actions-observations format: CActionRobotMovement2D + "
-			"CSensoryFrame with a CObservationImage; or with --obs-only the observations-only format "
+			"CSensoryFrame with a CObservationImage; or with --obs-only the observations-only "
+			"format "
 			"with CObservationOdometry at its own rate), the images in dataset_Images/ (MRPT's "
 			"external-image convention), map.txt, gt_path.txt ('timestamp x y yaw' per image). "
 			"Deterministic for a seed. See share/codemark/simul.ini for every setting.",
 			' ', "0.1");
 		TCLAP::ValueArg<std::string> config(
-			"c", "config", "the dataset ini (sections [map] [trajectory] [odometry] [camera] [render] "
+			"c", "config",
+			"the dataset ini (sections [map] [trajectory] [odometry] [camera] [render] "
 			"[dataset]); without it the built-in defaults (a 6 x 4 m room, 12 landmarks, one loop)",
 			false, "", "INI", cmd);
-		TCLAP::ValueArg<std::string> out("o", "out", "output directory (created if missing)", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> out(
+			"o", "out", "output directory (created if missing)", true, "", "DIR", cmd);
 		TCLAP::SwitchArg obsOnly("", "obs-only", "write the observations-only rawlog format", cmd);
-		TCLAP::ValueArg<unsigned int> seed("s", "seed", "override [dataset] seed", false, 0, "N", cmd);
+		TCLAP::ValueArg<unsigned int> seed(
+			"s", "seed", "override [dataset] seed", false, 0, "N", cmd);
 		TCLAP::ValueArg<int> frames(
 			"", "max-frames", "stop after N images (0: the whole trajectory)", false, 0, "N", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
@@ -71,7 +77,8 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-simul: " << codemark::app::oneLine(mrpt::exception_to_str(e)) << "\n";
+		std::cerr << "codemark-simul: " << codemark::app::oneLine(mrpt::exception_to_str(e))
+				  << "\n";
 	}
 	return 1;
 }

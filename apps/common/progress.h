@@ -16,7 +16,9 @@ class ProgressBar
 {
    public:
 	explicit ProgressBar(std::string label, bool enabled = true)
-		: label_(std::move(label)), enabled_(enabled), tty_(isatty(fileno(stderr)) != 0),
+		: label_(std::move(label)),
+		  enabled_(enabled),
+		  tty_(isatty(fileno(stderr)) != 0),
 		  start_(std::chrono::steady_clock::now())
 	{
 	}
@@ -37,11 +39,14 @@ class ProgressBar
 			}
 			return;
 		}
-		const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+		const double el =
+			std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 		const double eta = done > 0 ? el * (total - done) / done : 0;
 		const int width = 30, fill = width * done / total;
-		std::fprintf(stderr, "\r%s [%s%s] %3d%% %ld/%ld  %.0fs left ", label_.c_str(),
-			std::string(fill, '#').c_str(), std::string(width - fill, '.').c_str(), pct, done, total, eta);
+		std::fprintf(
+			stderr, "\r%s [%s%s] %3d%% %ld/%ld  %.0fs left ", label_.c_str(),
+			std::string(fill, '#').c_str(), std::string(width - fill, '.').c_str(), pct, done,
+			total, eta);
 		std::fflush(stderr);
 		drawn_ = true;
 	}

@@ -192,11 +192,11 @@ class Aruco
 struct Stats
 {
 	long truths = 0;  // visible prints
-	long detected = 0;  // found with the right ID at the right place
-	long wrong_id = 0;  // a detection on a print with another ID
-	long false_pos = 0;  // a detection where no print is
+	long detected = 0;	// found with the right ID at the right place
+	long wrong_id = 0;	// a detection on a print with another ID
+	long false_pos = 0;	 // a detection where no print is
 	double err_sum = 0, err_max = 0;  // corner errors [px]
-	double radial_sum = 0;  // signed error along centre -> corner (outward positive) [px]
+	double radial_sum = 0;	// signed error along centre -> corner (outward positive) [px]
 	long err_n = 0;
 	std::vector<double> times_us;  // thread CPU time per frame
 	std::vector<double> wall_us;  // wall time per frame
@@ -236,7 +236,8 @@ void score(const std::vector<Det>& dets, const std::vector<cb::PrintTruth>& trut
 		{
 			std::vector<cv::Point2f> q;
 			for (const auto& p : truth[i].corners_px) q.emplace_back(float(p.x()), float(p.y()));
-			if (cv::pointPolygonTest(q, cv::Point2f(float(c.x()), float(c.y())), false) >= 0) hit = int(i);
+			if (cv::pointPolygonTest(q, cv::Point2f(float(c.x()), float(c.y())), false) >= 0)
+				hit = int(i);
 		}
 		if (hit < 0)
 		{
@@ -303,12 +304,14 @@ void randomIds(Placement& pl, size_t n, cv::RNG& rng)
 	{
 		std::vector<int> all(range[k]);
 		std::iota(all.begin(), all.end(), 0);
-		for (size_t i = 0; i < n; ++i) std::swap(all[i], all[i + size_t(rng.uniform(0, int(all.size() - i)))]);
+		for (size_t i = 0; i < n; ++i)
+			std::swap(all[i], all[i + size_t(rng.uniform(0, int(all.size() - i)))]);
 		pl.ids[k].assign(all.begin(), all.begin() + long(n));
 	}
 }
 
-bool allVisible(const Placement& pl, const CameraModel& cam, const CPose3D& world_T_camera, double ref_m)
+bool allVisible(
+	const Placement& pl, const CameraModel& cam, const CPose3D& world_T_camera, double ref_m)
 {
 	for (int k = 0; k < 3; ++k)
 		for (const auto& p : placed(pl, cb::PrintKind(k), ref_m))
@@ -320,7 +323,7 @@ bool allVisible(const Placement& pl, const CameraModel& cam, const CPose3D& worl
 struct StageLog
 {
 	std::vector<double> seg, comp, edg, segm, quad, sub, code, total;
-	std::vector<int> rois;  // ROIs examined per frame
+	std::vector<int> rois;	// ROIs examined per frame
 	int lastRois() const { return rois.empty() ? 0 : rois.back(); }
 	void add(const codemark::detect::StageTimings& t, int n_rois)
 	{
@@ -338,7 +341,8 @@ struct StageLog
 	{
 		std::ostringstream s;
 		s << "| " << name;
-		for (const auto* v : {&seg, &comp, &edg, &segm, &quad, &sub, &code, &total}) s << " | " << fmt(median(*v), 1);
+		for (const auto* v : {&seg, &comp, &edg, &segm, &quad, &sub, &code, &total})
+			s << " | " << fmt(median(*v), 1);
 		s << " |\n";
 		return s.str();
 	}
@@ -347,8 +351,9 @@ struct StageLog
 	 * outliers that would dominate means). */
 	std::string shares() const
 	{
-		std::vector<std::pair<double, std::string>> st{{median(seg), "segmentation"}, {median(comp), "components"},
-			{median(edg), "edgels"}, {median(segm), "segments"}, {median(quad), "quads"}, {median(sub), "subpixel"},
+		std::vector<std::pair<double, std::string>> st{
+			{median(seg), "segmentation"}, {median(comp), "components"}, {median(edg), "edgels"},
+			{median(segm), "segments"},	   {median(quad), "quads"},		 {median(sub), "subpixel"},
 			{median(code), "code"}};
 		double sum = 0;
 		for (const auto& x : st) sum += x.first;
@@ -356,7 +361,8 @@ struct StageLog
 		std::ostringstream s;
 		s << "median total " << fmt(median(total) / 1e3, 3) << " ms, shares of the stage medians: ";
 		for (size_t i = 0; i < st.size(); ++i)
-			s << (i ? ", " : "") << st[i].second << " " << fmt(sum > 0 ? 100 * st[i].first / sum : 0, 0) << "%";
+			s << (i ? ", " : "") << st[i].second << " "
+			  << fmt(sum > 0 ? 100 * st[i].first / sum : 0, 0) << "%";
 		return s.str();
 	}
 };
@@ -387,9 +393,9 @@ std::string utcNow()
 struct Config
 {
 	bool quick = false;
-	int positions = 16;  // image positions per (distance, angle)
+	int positions = 16;	 // image positions per (distance, angle)
 	int clutter_frames = 1000;
-	int scale_frames = 10;  // frames per image size / landmark count
+	int scale_frames = 10;	// frames per image size / landmark count
 	uint64_t seed = 1;
 	std::string out;
 	std::string revision;  // source revision, printed in the report
@@ -404,7 +410,7 @@ int runBench(const Config& cfg)
 	const CameraModel cam = CameraModel::paperDefault();
 	const codemark::LandmarkGeometry geometry;
 	const codemark::detect::DetectorOptions dopts;
-	const cb::Effects effects;  // blur 0.8, noise 2
+	const cb::Effects effects;	// blur 0.8, noise 2
 	sim::RenderOptions textured;
 	textured.background = sim::Background::Textured;
 	sim::RenderOptions cluttered;
@@ -417,14 +423,16 @@ int runBench(const Config& cfg)
 	StageLog* stage_sink = nullptr;
 	std::vector<Detector> dets{
 		{"codemark", cb::PrintKind::Codemark,
-		 [&](const cv::Mat& bgr, const CameraModel& c) {
+		 [&](const cv::Mat& bgr, const CameraModel& c)
+		 {
 			 const auto r = codemark::detect::detect(bgr, c, geometry, dopts);
 			 if (stage_sink) stage_sink->add(r.timings, r.counts.rois);
 			 std::vector<Det> out;
 			 for (const auto& l : r.landmarks) out.push_back({l.detection.id, l.detection.corners});
 			 return out;
 		 }},
-		{"ArUco", cb::PrintKind::Aruco, [&](const cv::Mat& bgr, const CameraModel&) { return aruco.run(bgr); }},
+		{"ArUco", cb::PrintKind::Aruco,
+		 [&](const cv::Mat& bgr, const CameraModel&) { return aruco.run(bgr); }},
 		{"AprilTag d1", cb::PrintKind::AprilTag,
 		 [&](const cv::Mat& bgr, const CameraModel&) { return tag1.run(bgr); }},
 		{"AprilTag d2", cb::PrintKind::AprilTag,
@@ -437,7 +445,8 @@ int runBench(const Config& cfg)
 	// Runs detector d on one frame; us = its thread CPU time; the wall time
 	// goes to *wall when given.
 	const auto timeRun = [&](size_t d, const cv::Mat& bgr, const CameraModel& c, double& us,
-							 std::vector<double>* wall = nullptr) {
+							 std::vector<double>* wall = nullptr)
+	{
 		const double w0 = nowUs(), p0 = processCpuUs(), t0 = cpuUs();
 		auto r = dets[d].run(bgr, c);
 		us = cpuUs() - t0;
@@ -446,7 +455,8 @@ int runBench(const Config& cfg)
 		if (wall) wall->push_back(nowUs() - w0);
 		return r;
 	};
-	const auto cvtFloor = [](const cv::Mat& bgr) {
+	const auto cvtFloor = [](const cv::Mat& bgr)
+	{
 		cv::Mat g;
 		const double t0 = cpuUs();
 		cv::cvtColor(bgr, g, cv::COLOR_BGR2GRAY);
@@ -463,12 +473,14 @@ int runBench(const Config& cfg)
 		lm.id = 37;
 		for (int i = 0; i < 4; ++i)
 		{
-			const CPose3D wc = sim::levelCameraLookingAt(lm, 1.0 + 0.7 * i, 0.3 * i, 0.05 * i, 0.1 * i - 0.1);
+			const CPose3D wc =
+				sim::levelCameraLookingAt(lm, 1.0 + 0.7 * i, 0.3 * i, 0.05 * i, 0.1 * i - 0.1);
 			sim::RenderOptions o = i % 2 ? cluttered : textured;
 			sim_diff = std::max(sim_diff, cb::checkAgainstSim(lm, cam, wc, o, effects, 100 + i));
 		}
 	}
-	std::array<Eigen::Vector2d, 4> offset;  // mean (detected - true) per detector, AprilTag unshifted
+	std::array<Eigen::Vector2d, 4>
+		offset;	 // mean (detected - true) per detector, AprilTag unshifted
 	{
 		sim::RenderOptions flat;
 		const cb::Effects none{0, 0};
@@ -479,14 +491,16 @@ int runBench(const Config& cfg)
 			for (int i = 0; i < 8; ++i)
 			{
 				MapLandmark lm;
-				const CPose3D wc = sim::levelCameraLookingAt(lm, 1.0 + 0.013 * i, 0.0, 0.0007 * i, 0.0009 * i);
+				const CPose3D wc =
+					sim::levelCameraLookingAt(lm, 1.0 + 0.013 * i, 0.0, 0.0007 * i, 0.0009 * i);
 				Placement pl;
 				pl.poses = {lm.world_T_landmark()};
 				pl.ids = {{{37}, {7}, {11}}};
-				const cb::Frame f = cb::renderFrame(placed(pl, dets[d].kind, ref_m), cam, wc, flat, none, 7 + i);
-				std::vector<Det> r = dets[d].name == "AprilTag d1" ? tag1.run(f.bgr, 0.0)
-					: dets[d].name == "AprilTag d2"					? tag2.run(f.bgr, 0.0)
-																	: dets[d].run(f.bgr, cam);
+				const cb::Frame f =
+					cb::renderFrame(placed(pl, dets[d].kind, ref_m), cam, wc, flat, none, 7 + i);
+				std::vector<Det> r = dets[d].name == "AprilTag d1"	 ? tag1.run(f.bgr, 0.0)
+									 : dets[d].name == "AprilTag d2" ? tag2.run(f.bgr, 0.0)
+																	 : dets[d].run(f.bgr, cam);
 				for (const Det& x : r)
 					for (const auto& tc : f.truth[0].corners_px)
 					{
@@ -504,8 +518,9 @@ int runBench(const Config& cfg)
 	std::cerr << "self-check: renderer vs sim::render max diff " << sim_diff << " grey levels\n";
 
 	// --- 1. The sweep: one print per frame, distances x angles x positions.
-	const std::vector<double> distances = cfg.quick ? std::vector<double>{0.5, 1, 2, 3, 4, 5}
-													: std::vector<double>{0.5, 0.75, 1, 1.5, 2, 2.5, 3, 4, 5};
+	const std::vector<double> distances =
+		cfg.quick ? std::vector<double>{0.5, 1, 2, 3, 4, 5}
+				  : std::vector<double>{0.5, 0.75, 1, 1.5, 2, 2.5, 3, 4, 5};
 	const std::vector<double> angles{0, 15, 30, 45, 60};
 	std::vector<std::vector<std::vector<Stats>>> sweep(
 		ND, std::vector<std::vector<Stats>>(distances.size(), std::vector<Stats>(angles.size())));
@@ -542,9 +557,14 @@ int runBench(const Config& cfg)
 				++sweep_frames;
 				for (size_t k = 0; k < ND; ++k)
 				{
-					const cb::Frame f = cb::renderFrame(placed(pl, dets[k].kind, ref_m), cam, wc, textured, effects, frame_seed);
+					const cb::Frame f = cb::renderFrame(
+						placed(pl, dets[k].kind, ref_m), cam, wc, textured, effects, frame_seed);
 					if (k == 0) floor_us.push_back(cvtFloor(f.bgr));
-					if (p == 0 && di == 0 && ai == 0) { double w = 0; timeRun(k, f.bgr, cam, w); }  // warm-up
+					if (p == 0 && di == 0 && ai == 0)
+					{
+						double w = 0;
+						timeRun(k, f.bgr, cam, w);
+					}  // warm-up
 					Stats s;
 					double us = 0;
 					stage_sink = k == 0 ? &stages_sweep : nullptr;
@@ -556,18 +576,31 @@ int runBench(const Config& cfg)
 					if (k == 0 && s.truths && !s.detected && !cfg.dump_dir.empty())
 					{
 						// The frame and its true corners, for the detector's engineer.
-						const std::string base = cfg.dump_dir + "/miss-" + fmt(distances[di], 2) + "m-" +
-							fmt(a * 180 / CV_PI, 0) + "deg-seed" + std::to_string(frame_seed);
+						const std::string base = cfg.dump_dir + "/miss-" + fmt(distances[di], 2) +
+												 "m-" + fmt(a * 180 / CV_PI, 0) + "deg-seed" +
+												 std::to_string(frame_seed);
 						cv::imwrite(base + ".png", f.bgr);
 						std::ofstream t(base + ".txt");
-						t << "# id " << f.truth[0].id << "; true reference corners TL TR BR BL [px], (0,0) = centre of the top-left pixel\n";
-						for (const auto& c : f.truth[0].corners_px) t << std::setprecision(10) << c.x() << " " << c.y() << "\n";
+						t << "# id " << f.truth[0].id
+						  << "; true reference corners TL TR BR BL [px], (0,0) = centre of the "
+							 "top-left pixel\n";
+						for (const auto& c : f.truth[0].corners_px)
+							t << std::setprecision(10) << c.x() << " " << c.y() << "\n";
 					}
 					if (k == 0 && s.truths && !s.detected && misses.size() < 30)
-						misses.push_back(fmt(distances[di], 2) + " m, " + fmt(a * 180 / CV_PI, 0) + " deg, ref. square " +
-							fmt(f.truth[0].ref_height_px, 1) + " px high, centre (" +
-							fmt(0.25 * (f.truth[0].corners_px[0] + f.truth[0].corners_px[1] + f.truth[0].corners_px[2] + f.truth[0].corners_px[3]).x(), 0) +
-							", " + fmt(0.25 * (f.truth[0].corners_px[0] + f.truth[0].corners_px[1] + f.truth[0].corners_px[2] + f.truth[0].corners_px[3]).y(), 0) +
+						misses.push_back(
+							fmt(distances[di], 2) + " m, " + fmt(a * 180 / CV_PI, 0) +
+							" deg, ref. square " + fmt(f.truth[0].ref_height_px, 1) +
+							" px high, centre (" +
+							fmt(0.25 * (f.truth[0].corners_px[0] + f.truth[0].corners_px[1] +
+										f.truth[0].corners_px[2] + f.truth[0].corners_px[3])
+										   .x(),
+								0) +
+							", " +
+							fmt(0.25 * (f.truth[0].corners_px[0] + f.truth[0].corners_px[1] +
+										f.truth[0].corners_px[2] + f.truth[0].corners_px[3])
+										   .y(),
+								0) +
 							"), seed " + std::to_string(frame_seed));
 					if (f.truth[0].ref_height_px >= 30) crit[k].add(s);
 					if (k == 0)
@@ -598,7 +631,8 @@ int runBench(const Config& cfg)
 			const auto r = timeRun(k, f.bgr, cam, us, &clutter[k].wall_us);
 			stage_sink = nullptr;
 			if (k == 0 && !cfg.clutter_dir.empty() && stages_clutter.lastRois() > 0)
-				cv::imwrite(cfg.clutter_dir + "/clutter-" + std::to_string(i) + "-rois" +
+				cv::imwrite(
+					cfg.clutter_dir + "/clutter-" + std::to_string(i) + "-rois" +
 						std::to_string(stages_clutter.lastRois()) + ".png",
 					f.bgr);
 			clutter[k].times_us.push_back(us);
@@ -621,7 +655,11 @@ int runBench(const Config& cfg)
 	for (const auto& wh : dims)
 	{
 		const CameraModel c = scaledCamera(wh.first, wh.second);
-		Growth g{std::to_string(wh.first) + "x" + std::to_string(wh.second), std::vector<Stats>(ND), {}, {}};
+		Growth g{
+			std::to_string(wh.first) + "x" + std::to_string(wh.second),
+			std::vector<Stats>(ND),
+			{},
+			{}};
 		for (int i = 0; i < cfg.scale_frames; ++i)
 		{
 			MapLandmark lm;
@@ -629,12 +667,19 @@ int runBench(const Config& cfg)
 			pl.poses = {lm.world_T_landmark()};
 			randomIds(pl, 1, rng);
 			const CPose3D wc = sim::levelCameraLookingAt(
-				lm, 2.0, (i % 2 ? 20 : -20) * CV_PI / 180, rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1));
+				lm, 2.0, (i % 2 ? 20 : -20) * CV_PI / 180, rng.uniform(-0.1, 0.1),
+				rng.uniform(-0.1, 0.1));
 			for (size_t k = 0; k < ND; ++k)
 			{
-				const cb::Frame f = cb::renderFrame(placed(pl, dets[k].kind, ref_m), c, wc, textured, effects, 700000 + uint64_t(i));
+				const cb::Frame f = cb::renderFrame(
+					placed(pl, dets[k].kind, ref_m), c, wc, textured, effects,
+					700000 + uint64_t(i));
 				if (k == 0) g.floor.push_back(cvtFloor(f.bgr));
-				if (i == 0) { double w = 0; timeRun(k, f.bgr, c, w); }  // warm-up at this size
+				if (i == 0)
+				{
+					double w = 0;
+					timeRun(k, f.bgr, c, w);
+				}  // warm-up at this size
 				double us = 0;
 				stage_sink = k == 0 ? &g.stages : nullptr;
 				const auto r = timeRun(k, f.bgr, c, us);
@@ -663,10 +708,13 @@ int runBench(const Config& cfg)
 			randomIds(pl, pl.poses.size(), rng);
 			MapLandmark centre;
 			const CPose3D wc = sim::levelCameraLookingAt(
-				centre, 2.5, rng.uniform(-10.0, 10.0) * CV_PI / 180, rng.uniform(-0.03, 0.03), rng.uniform(-0.03, 0.03));
+				centre, 2.5, rng.uniform(-10.0, 10.0) * CV_PI / 180, rng.uniform(-0.03, 0.03),
+				rng.uniform(-0.03, 0.03));
 			for (size_t k = 0; k < ND; ++k)
 			{
-				const cb::Frame f = cb::renderFrame(placed(pl, dets[k].kind, ref_m), cam, wc, textured, effects, 800000 + uint64_t(i));
+				const cb::Frame f = cb::renderFrame(
+					placed(pl, dets[k].kind, ref_m), cam, wc, textured, effects,
+					800000 + uint64_t(i));
 				if (k == 0) g.floor.push_back(cvtFloor(f.bgr));
 				double us = 0;
 				stage_sink = k == 0 ? &g.stages : nullptr;
@@ -700,58 +748,83 @@ int runBench(const Config& cfg)
 	   << (cfg.revision.empty() ? std::string() : "- source: " + cfg.revision + "\n")
 	   << "- date: " << utcNow() << "; whole run " << fmt(total_s, 0) << " s"
 	   << (cfg.quick ? " (**--quick smoke run: small samples**)" : "") << "\n"
-	   << "- camera: fx = fy = 800 at 640x480, no distortion (`CameraModel::paperDefault()`); every detector "
-		  "single-threaded (`cv::setNumThreads(1)`, AprilTag `nthreads = 1`), each timed from the BGR frame "
+	   << "- camera: fx = fy = 800 at 640x480, no distortion (`CameraModel::paperDefault()`); "
+		  "every detector "
+		  "single-threaded (`cv::setNumThreads(1)`, AprilTag `nthreads = 1`), each timed from the "
+		  "BGR frame "
 		  "(the peers' grey conversion is part of their time)\n"
-	   << "- prints: codemark (160 mm inner frame = reference square), ArUco DICT_4X4_50 (160 mm outer black "
-		  "edge, `CORNER_REFINE_SUBPIX`, defaults otherwise), AprilTag 3 tag36h11 (160 mm outer black edge, "
-		  "`quad_decimate` 1 and 2, library defaults otherwise); each with its quiet margin (markers: one cell)\n"
-	   << "- rendering: libs/sim's exact pixel coverage and background for every print (bench/detect/"
-		  "print_render.*), Gaussian blur sigma 0.8 px then noise sigma 2 grey levels, identical for all; "
+	   << "- prints: codemark (160 mm inner frame = reference square), ArUco DICT_4X4_50 (160 mm "
+		  "outer black "
+		  "edge, `CORNER_REFINE_SUBPIX`, defaults otherwise), AprilTag 3 tag36h11 (160 mm outer "
+		  "black edge, "
+		  "`quad_decimate` 1 and 2, library defaults otherwise); each with its quiet margin "
+		  "(markers: one cell)\n"
+	   << "- rendering: libs/sim's exact pixel coverage and background for every print "
+		  "(bench/detect/"
+		  "print_render.*), Gaussian blur sigma 0.8 px then noise sigma 2 grey levels, identical "
+		  "for all; "
 		  "check: our landmark rendered this way differs from `sim::render()` by at most "
 	   << fmt(sim_diff, 0) << " grey level(s)\n"
-	   << "- ground truth: exact projection of the reference square's corners; AprilTag's corners shifted by "
-		  "-0.5 px (its pixel centres are at i + 0.5); corners matched to the nearest true corner\n\n";
+	   << "- ground truth: exact projection of the reference square's corners; AprilTag's corners "
+		  "shifted by "
+		  "-0.5 px (its pixel centres are at i + 0.5); corners matched to the nearest true "
+		  "corner\n\n";
 
 	md << "## Corner conventions (noise-free frontal renders, 8 sub-pixel positions at 1 m)\n\n"
-	   << "Mean (detected - true) corner offset before any shift [px]:\n\n| detector | du | dv |\n|---|---|---|\n";
+	   << "Mean (detected - true) corner offset before any shift [px]:\n\n| detector | du | dv "
+		  "|\n|---|---|---|\n";
 	for (size_t k = 0; k < ND; ++k)
-		md << "| " << dets[k].name << " | " << fmt(offset[k].x(), 3) << " | " << fmt(offset[k].y(), 3) << " |\n";
-	md << "\nSingle-threaded check, process CPU time / calling thread's CPU time over all timed runs (1.00: "
+		md << "| " << dets[k].name << " | " << fmt(offset[k].x(), 3) << " | "
+		   << fmt(offset[k].y(), 3) << " |\n";
+	md << "\nSingle-threaded check, process CPU time / calling thread's CPU time over all timed "
+		  "runs (1.00: "
 		  "nothing ran in another thread): ";
-	for (size_t k = 0; k < ND; ++k) md << (k ? ", " : "") << dets[k].name << " " << fmt(proc_cpu[k] / thread_cpu[k], 3);
+	for (size_t k = 0; k < ND; ++k)
+		md << (k ? ", " : "") << dets[k].name << " " << fmt(proc_cpu[k] / thread_cpu[k], 3);
 	md << ".\n\n";
 
 	md << "## Time per frame and ratios (one landmark in view)\n\n"
-	   << "Sweep: " << sweep_frames << " frames per detector (" << distances.size() << " distances x "
-	   << angles.size() << " angles x " << cfg.positions << " image positions, textured background); clutter: "
-	   << cfg.clutter_frames << " background-only frames (the same frames for all). Median time per frame [ms]: the thread's CPU time "
-		  "(CLOCK_THREAD_CPUTIME_ID: on this shared machine, wall time also counts waits for a core; every "
-		  "detector runs in the calling thread), wall-time medians below for reference; the ratios use CPU time. "
+	   << "Sweep: " << sweep_frames << " frames per detector (" << distances.size()
+	   << " distances x " << angles.size() << " angles x " << cfg.positions
+	   << " image positions, textured background); clutter: " << cfg.clutter_frames
+	   << " background-only frames (the same frames for all). Median time per frame [ms]: the "
+		  "thread's CPU time "
+		  "(CLOCK_THREAD_CPUTIME_ID: on this shared machine, wall time also counts waits for a "
+		  "core; every "
+		  "detector runs in the calling thread), wall-time medians below for reference; the ratios "
+		  "use CPU time. "
 	   << "The memory floor is one `cv::cvtColor(BGR2GRAY)` of the frame, timed the same way.\n\n"
-	   << "| | codemark | ArUco | AprilTag d1 | AprilTag d2 | cvtColor floor |\n|---|---|---|---|---|---|\n"
-	   << "| one landmark, CPU time [ms] | " << fmt(med[0] / 1e3, 3) << " | " << fmt(med[1] / 1e3, 3) << " | "
-	   << fmt(med[2] / 1e3, 3) << " | " << fmt(med[3] / 1e3, 3) << " | " << fmt(median(floor_us) / 1e3, 3) << " |\n"
-	   << "| background only, CPU time [ms] | " << fmt(med_clutter[0] / 1e3, 3) << " | " << fmt(med_clutter[1] / 1e3, 3)
-	   << " | " << fmt(med_clutter[2] / 1e3, 3) << " | " << fmt(med_clutter[3] / 1e3, 3) << " | "
-	   << fmt(median(clutter_floor) / 1e3, 3) << " |\n"
+	   << "| | codemark | ArUco | AprilTag d1 | AprilTag d2 | cvtColor floor "
+		  "|\n|---|---|---|---|---|---|\n"
+	   << "| one landmark, CPU time [ms] | " << fmt(med[0] / 1e3, 3) << " | "
+	   << fmt(med[1] / 1e3, 3) << " | " << fmt(med[2] / 1e3, 3) << " | " << fmt(med[3] / 1e3, 3)
+	   << " | " << fmt(median(floor_us) / 1e3, 3) << " |\n"
+	   << "| background only, CPU time [ms] | " << fmt(med_clutter[0] / 1e3, 3) << " | "
+	   << fmt(med_clutter[1] / 1e3, 3) << " | " << fmt(med_clutter[2] / 1e3, 3) << " | "
+	   << fmt(med_clutter[3] / 1e3, 3) << " | " << fmt(median(clutter_floor) / 1e3, 3) << " |\n"
 	   << "| one landmark, wall time [ms] | " << fmt(median(all[0].wall_us) / 1e3, 3) << " | "
-	   << fmt(median(all[1].wall_us) / 1e3, 3) << " | " << fmt(median(all[2].wall_us) / 1e3, 3) << " | "
-	   << fmt(median(all[3].wall_us) / 1e3, 3) << " | |\n"
-	   << "| background only, wall time [ms] | " << fmt(median(clutter[0].wall_us) / 1e3, 3) << " | "
-	   << fmt(median(clutter[1].wall_us) / 1e3, 3) << " | " << fmt(median(clutter[2].wall_us) / 1e3, 3) << " | "
+	   << fmt(median(all[1].wall_us) / 1e3, 3) << " | " << fmt(median(all[2].wall_us) / 1e3, 3)
+	   << " | " << fmt(median(all[3].wall_us) / 1e3, 3) << " | |\n"
+	   << "| background only, wall time [ms] | " << fmt(median(clutter[0].wall_us) / 1e3, 3)
+	   << " | " << fmt(median(clutter[1].wall_us) / 1e3, 3) << " | "
+	   << fmt(median(clutter[2].wall_us) / 1e3, 3) << " | "
 	   << fmt(median(clutter[3].wall_us) / 1e3, 3) << " | |\n\n";
-	md << "Ratios codemark / peer (target: <= 0.1 vs ArUco and AprilTag d2 with one landmark, <= 0.05 vs ArUco "
+	md << "Ratios codemark / peer (target: <= 0.1 vs ArUco and AprilTag d2 with one landmark, <= "
+		  "0.05 vs ArUco "
 		  "on background-only frames):\n\n"
-	   << "| frames | / ArUco | / AprilTag d1 | / AprilTag d2 | / cvtColor |\n|---|---|---|---|---|\n"
-	   << "| one landmark | " << fmt(med[0] / med[1], 3) << " | " << fmt(med[0] / med[2], 3) << " | "
-	   << fmt(med[0] / med[3], 3) << " | " << fmt(med[0] / median(floor_us), 2) << " |\n"
+	   << "| frames | / ArUco | / AprilTag d1 | / AprilTag d2 | / cvtColor "
+		  "|\n|---|---|---|---|---|\n"
+	   << "| one landmark | " << fmt(med[0] / med[1], 3) << " | " << fmt(med[0] / med[2], 3)
+	   << " | " << fmt(med[0] / med[3], 3) << " | " << fmt(med[0] / median(floor_us), 2) << " |\n"
 	   << "| background only | " << fmt(med_clutter[0] / med_clutter[1], 3) << " | "
-	   << fmt(med_clutter[0] / med_clutter[2], 3) << " | " << fmt(med_clutter[0] / med_clutter[3], 3) << " | "
+	   << fmt(med_clutter[0] / med_clutter[2], 3) << " | "
+	   << fmt(med_clutter[0] / med_clutter[3], 3) << " | "
 	   << fmt(med_clutter[0] / median(clutter_floor), 2) << " |\n\n";
 
-	md << "codemark's own stage timings, medians over frames [us] (the stages' medians need not add up to the "
-		  "total's):\n\n| frames | segmentation | components | edgels | segments | quads | subpixel | code | total |\n"
+	md << "codemark's own stage timings, medians over frames [us] (the stages' medians need not "
+		  "add up to the "
+		  "total's):\n\n| frames | segmentation | components | edgels | segments | quads | "
+		  "subpixel | code | total |\n"
 	   << "|---|---|---|---|---|---|---|---|---|\n"
 	   << stages_sweep.row("one landmark (sweep)") << stages_clutter.row("background only");
 	for (const auto& g : sizes) md << g.stages.row(g.label + ", one landmark");
@@ -763,18 +836,23 @@ int runBench(const Config& cfg)
 			with += n > 0;
 			sum += n;
 		}
-		md << "\nBackground-only frames in which codemark examined any ROI (a candidate fill past the component "
+		md << "\nBackground-only frames in which codemark examined any ROI (a candidate fill past "
+			  "the component "
 			  "tests, reaching the edgel stage): "
 		   << with << " of " << stages_clutter.rois.size() << ", " << sum << " ROIs in all.\n";
 	}
 	md << "\n";
 
-	md << "## Detection\n\nReference square height in the sweep: " << fmt(min_h, 1) << " to " << fmt(max_h, 1)
-	   << " px. Rate over frames where it spans >= 30 px vertically (all angles 0-60 deg; target >= 99.5%):\n\n"
-	   << "| detector | frames | detected | rate | wrong IDs | false positives |\n|---|---|---|---|---|---|\n";
+	md << "## Detection\n\nReference square height in the sweep: " << fmt(min_h, 1) << " to "
+	   << fmt(max_h, 1)
+	   << " px. Rate over frames where it spans >= 30 px vertically (all angles 0-60 deg; target "
+		  ">= 99.5%):\n\n"
+	   << "| detector | frames | detected | rate | wrong IDs | false positives "
+		  "|\n|---|---|---|---|---|---|\n";
 	for (size_t k = 0; k < ND; ++k)
 		md << "| " << dets[k].name << " | " << crit[k].truths << " | " << crit[k].detected << " | "
-		   << fmt(100 * crit[k].rate(), 2) << "% | " << crit[k].wrong_id << " | " << crit[k].false_pos << " |\n";
+		   << fmt(100 * crit[k].rate(), 2) << "% | " << crit[k].wrong_id << " | "
+		   << crit[k].false_pos << " |\n";
 	md << "\nDetection rate per distance (rows) and viewing angle (columns), " << cfg.positions
 	   << " frames per cell:\n\n";
 	for (size_t k = 0; k < ND; ++k)
@@ -798,47 +876,62 @@ int runBench(const Config& cfg)
 		md << "\n";
 	}
 
-	md << "## Corner error against the exact projection\n\nMean / max over all corners of correct detections "
-		  "[px], per distance, all angles (target: codemark mean <= 0.1 px and no worse than AprilTag d1 at each "
+	md << "## Corner error against the exact projection\n\nMean / max over all corners of correct "
+		  "detections "
+		  "[px], per distance, all angles (target: codemark mean <= 0.1 px and no worse than "
+		  "AprilTag d1 at each "
 		  "distance):\n\n| distance | ref. square [px] |";
 	for (const auto& d : dets) md << " " << d.name << " mean | max |";
-	md << " codemark <= AprilTag d1 | codemark outward bias | AprilTag d1 outward bias |\n|---|---|";
+	md << " codemark <= AprilTag d1 | codemark outward bias | AprilTag d1 outward bias "
+		  "|\n|---|---|";
 	for (size_t k = 0; k < ND; ++k) md << "---|---|";
 	md << "---|---|---|\n";
 	for (size_t di = 0; di < distances.size(); ++di)
 	{
-		md << "| " << fmt(distances[di], 2) << " m | " << fmt(800 * ref_m / distances[di], 0) << " |";
+		md << "| " << fmt(distances[di], 2) << " m | " << fmt(800 * ref_m / distances[di], 0)
+		   << " |";
 		std::vector<Stats> row(ND);
 		for (size_t k = 0; k < ND; ++k)
 		{
 			for (size_t ai = 0; ai < angles.size(); ++ai) row[k].add(sweep[k][di][ai]);
-			md << " " << fmt(row[k].meanErr(), 3) << " | " << fmt(row[k].err_n ? row[k].err_max : NAN, 3) << " |";
+			md << " " << fmt(row[k].meanErr(), 3) << " | "
+			   << fmt(row[k].err_n ? row[k].err_max : NAN, 3) << " |";
 		}
 		const bool ok = row[0].err_n && row[2].err_n ? row[0].meanErr() <= row[2].meanErr() : false;
 		md << " " << (ok ? "yes" : "**no**") << " | " << fmt(row[0].meanRadial(), 3) << " | "
 		   << fmt(row[2].meanRadial(), 3) << " |\n";
 	}
 	md << "| all | |";
-	for (size_t k = 0; k < ND; ++k) md << " " << fmt(all[k].meanErr(), 3) << " | " << fmt(all[k].err_max, 3) << " |";
+	for (size_t k = 0; k < ND; ++k)
+		md << " " << fmt(all[k].meanErr(), 3) << " | " << fmt(all[k].err_max, 3) << " |";
 	md << " | " << fmt(all[0].meanRadial(), 3) << " | " << fmt(all[2].meanRadial(), 3) << " |\n\n"
-	   << "Outward bias: mean signed corner error along the line from the square's centre through the true corner "
-		  "(positive: the detected square is too large) [px]; a bias near the mean error means a systematic "
+	   << "Outward bias: mean signed corner error along the line from the square's centre through "
+		  "the true corner "
+		  "(positive: the detected square is too large) [px]; a bias near the mean error means a "
+		  "systematic "
 		  "offset, a small one means noise.\n\n";
 
-	md << "## False detections\n\n| detector | background-only frames | false detections | frames with any | "
+	md << "## False detections\n\n| detector | background-only frames | false detections | frames "
+		  "with any | "
 		  "sweep: wrong IDs | sweep: false positives |\n|---|---|---|---|---|---|\n";
 	for (size_t k = 0; k < ND; ++k)
-		md << "| " << dets[k].name << " | " << cfg.clutter_frames << " | " << clutter[k].false_pos << " | "
-		   << clutter_any[k] << " | " << all[k].wrong_id << " | " << all[k].false_pos << " |\n";
-	md << "\nBackground-only frames: libs/sim's Cluttered background with 6-20 distractors (green blobs and "
-		  "rectangles, black frames filled with red, blue, white or grey, posters with black and green print, "
-		  "marker-like black squares with white grids), blur and noise as above, no landmark or marker. Every "
+		md << "| " << dets[k].name << " | " << cfg.clutter_frames << " | " << clutter[k].false_pos
+		   << " | " << clutter_any[k] << " | " << all[k].wrong_id << " | " << all[k].false_pos
+		   << " |\n";
+	md << "\nBackground-only frames: libs/sim's Cluttered background with 6-20 distractors (green "
+		  "blobs and "
+		  "rectangles, black frames filled with red, blue, white or grey, posters with black and "
+		  "green print, "
+		  "marker-like black squares with white grids), blur and noise as above, no landmark or "
+		  "marker. Every "
 		  "detection on them is false.\n\n";
 
-	const auto growthTable = [&](const std::vector<Growth>& gs, const std::string& head) {
+	const auto growthTable = [&](const std::vector<Growth>& gs, const std::string& head)
+	{
 		md << "| " << head << " |";
 		for (const auto& d : dets) md << " " << d.name << " [ms] |";
-		md << " cvtColor [ms] | codemark / ArUco | / AprilTag d1 | / AprilTag d2 | found (cm, Ar, d1, d2) |\n|---|";
+		md << " cvtColor [ms] | codemark / ArUco | / AprilTag d1 | / AprilTag d2 | found (cm, Ar, "
+			  "d1, d2) |\n|---|";
 		for (size_t k = 0; k < ND + 5; ++k) md << "---|";
 		md << "\n";
 		for (const auto& g : gs)
@@ -850,18 +943,21 @@ int runBench(const Config& cfg)
 				m[k] = median(g.s[k].times_us);
 				md << " " << fmt(m[k] / 1e3, 3) << " |";
 			}
-			md << " " << fmt(median(g.floor) / 1e3, 3) << " | " << fmt(m[0] / m[1], 3) << " | " << fmt(m[0] / m[2], 3)
-			   << " | " << fmt(m[0] / m[3], 3) << " |";
-			for (size_t k = 0; k < ND; ++k) md << (k ? ", " : " ") << g.s[k].detected << "/" << g.s[k].truths;
+			md << " " << fmt(median(g.floor) / 1e3, 3) << " | " << fmt(m[0] / m[1], 3) << " | "
+			   << fmt(m[0] / m[2], 3) << " | " << fmt(m[0] / m[3], 3) << " |";
+			for (size_t k = 0; k < ND; ++k)
+				md << (k ? ", " : " ") << g.s[k].detected << "/" << g.s[k].truths;
 			md << " |\n";
 		}
 		md << "\n";
 	};
 	md << "## How the cost grows\n\nMedian CPU time per frame, " << cfg.scale_frames
-	   << " frames per row. Image size: one landmark at 2 m, +-20 deg, near the image centre, fx = 800 * width / "
+	   << " frames per row. Image size: one landmark at 2 m, +-20 deg, near the image centre, fx = "
+		  "800 * width / "
 		  "640 (the same landmark, scaled):\n\n";
 	growthTable(sizes, "image");
-	md << "Landmarks in view at 640x480: a grid of 1, 4 or 16 prints 0.3 m apart on a wall 2.5 m away (about 51 px "
+	md << "Landmarks in view at 640x480: a grid of 1, 4 or 16 prints 0.3 m apart on a wall 2.5 m "
+		  "away (about 51 px "
 		  "reference squares), -10 to 10 deg:\n\n";
 	growthTable(counts, "landmarks");
 
@@ -875,32 +971,43 @@ int runBench(const Config& cfg)
 		for (size_t k = 0; k < ND; ++k)
 			for (size_t ai = 0; ai < angles.size(); ++ai) row[k].add(sweep[k][di][ai]);
 		worst_err = std::max(worst_err, row[0].meanErr());
-		if (!(row[0].err_n && row[0].meanErr() <= 0.1 && (!row[2].err_n || row[0].meanErr() <= row[2].meanErr())))
+		if (!(row[0].err_n && row[0].meanErr() <= 0.1 &&
+			  (!row[2].err_n || row[0].meanErr() <= row[2].meanErr())))
 			err_ok = false;
 	}
 	const auto verdict = [](bool ok) { return ok ? "met" : "**missed**"; };
 	md << "## Targets (issue 3)\n\n| target | measured | |\n|---|---|---|\n"
-	   << "| one landmark: codemark <= 0.1x ArUco | " << fmt(med[0] / med[1], 3) << "x | " << verdict(med[0] <= 0.1 * med[1]) << " |\n"
-	   << "| one landmark: codemark <= 0.1x AprilTag d2 | " << fmt(med[0] / med[3], 3) << "x | " << verdict(med[0] <= 0.1 * med[3]) << " |\n"
-	   << "| background only: codemark <= 0.05x ArUco | " << fmt(med_clutter[0] / med_clutter[1], 3) << "x | "
-	   << verdict(med_clutter[0] <= 0.05 * med_clutter[1]) << " |\n"
+	   << "| one landmark: codemark <= 0.1x ArUco | " << fmt(med[0] / med[1], 3) << "x | "
+	   << verdict(med[0] <= 0.1 * med[1]) << " |\n"
+	   << "| one landmark: codemark <= 0.1x AprilTag d2 | " << fmt(med[0] / med[3], 3) << "x | "
+	   << verdict(med[0] <= 0.1 * med[3]) << " |\n"
+	   << "| background only: codemark <= 0.05x ArUco | " << fmt(med_clutter[0] / med_clutter[1], 3)
+	   << "x | " << verdict(med_clutter[0] <= 0.05 * med_clutter[1]) << " |\n"
 	   << "| >= 99.5% detected (>= 30 px, <= 60 deg) | " << fmt(100 * crit[0].rate(), 2) << "% | "
 	   << verdict(crit[0].rate() >= 0.995) << " |\n"
-	   << "| 0 false positives on background-only frames | " << clutter[0].false_pos << " | " << verdict(clutter[0].false_pos == 0) << " |\n"
-	   << "| 0 wrong IDs (sweep and growth scenes) | " << all[0].wrong_id + [&] {
-			  long w = 0;
-			  for (const auto& g : sizes) w += g.s[0].wrong_id;
-			  for (const auto& g : counts) w += g.s[0].wrong_id;
-			  return w;
-		  }() << " | " << verdict(all[0].wrong_id == 0) << " |\n"
-	   << "| mean corner error <= 0.1 px and <= AprilTag d1 at each distance | worst distance: " << fmt(worst_err, 3)
-	   << " px | " << verdict(err_ok) << " |\n\n";
+	   << "| 0 false positives on background-only frames | " << clutter[0].false_pos << " | "
+	   << verdict(clutter[0].false_pos == 0) << " |\n"
+	   << "| 0 wrong IDs (sweep and growth scenes) | "
+	   << all[0].wrong_id +
+			  [&]
+	{
+		long w = 0;
+		for (const auto& g : sizes) w += g.s[0].wrong_id;
+		for (const auto& g : counts) w += g.s[0].wrong_id;
+		return w;
+	}() << " | "
+	   << verdict(all[0].wrong_id == 0) << " |\n"
+	   << "| mean corner error <= 0.1 px and <= AprilTag d1 at each distance | worst distance: "
+	   << fmt(worst_err, 3) << " px | " << verdict(err_ok) << " |\n\n";
 
 	// What to act on when a target is missed.
 	md << "## Where codemark stands\n\n";
-	const auto timing = [&](const std::string& what, double ratio, double bound, const StageLog& st) {
+	const auto timing = [&](const std::string& what, double ratio, double bound, const StageLog& st)
+	{
 		md << "- " << what << ": " << fmt(ratio, 3) << "x against <= " << fmt(bound, 2) << "x: "
-		   << (ratio <= bound ? "met" : "**missed**, codemark must become " + fmt(ratio / bound, 2) + "x faster")
+		   << (ratio <= bound
+				   ? "met"
+				   : "**missed**, codemark must become " + fmt(ratio / bound, 2) + "x faster")
 		   << "; codemark's stages (wall): " << st.shares() << ".\n";
 	};
 	timing("one landmark vs ArUco", med[0] / med[1], 0.1, stages_sweep);
@@ -922,14 +1029,20 @@ int runBench(const Config& cfg)
 			const bool over = c0.meanErr() > 0.1, worse = c2.err_n && c0.meanErr() > c2.meanErr();
 			if (!over && !worse) continue;
 			any = true;
-			md << "at " << fmt(distances[di], 2) << " m the mean is " << fmt(c0.meanErr(), 3) << " px (AprilTag d1 "
-			   << fmt(c2.meanErr(), 3) << " px" << (over ? ", above the 0.1 px bound" : "")
-			   << (worse ? ", " + fmt(c0.meanErr() - c2.meanErr(), 3) + " px worse than AprilTag d1" : "") << "); ";
+			md << "at " << fmt(distances[di], 2) << " m the mean is " << fmt(c0.meanErr(), 3)
+			   << " px (AprilTag d1 " << fmt(c2.meanErr(), 3) << " px"
+			   << (over ? ", above the 0.1 px bound" : "")
+			   << (worse ? ", " + fmt(c0.meanErr() - c2.meanErr(), 3) + " px worse than AprilTag d1"
+						 : "")
+			   << "); ";
 		}
-		md << (any ? "the subpixel stage (edge profiles, line fits) sets it.\n" : "met at every distance.\n");
+		md
+			<< (any ? "the subpixel stage (edge profiles, line fits) sets it.\n"
+					: "met at every distance.\n");
 	}
 	md << "- codemark's missed sweep frames (up to 30 listed; " << all[0].truths - all[0].detected
-	   << " in all; `codemark-bench-detect --dump-misses DIR` writes them as PNG with their true corners):"
+	   << " in all; `codemark-bench-detect --dump-misses DIR` writes them as PNG with their true "
+		  "corners):"
 	   << (misses.empty() ? " none" : "") << "\n";
 	for (const auto& m : misses) md << "  - " << m << "\n";
 
@@ -954,17 +1067,33 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"Detection benchmark: codemark vs OpenCV ArUco and AprilTag 3 on the same rendered scenes "
+			"Detection benchmark: codemark vs OpenCV ArUco and AprilTag 3 on the same rendered "
+			"scenes "
 			"(issue 3). Prints a Markdown report.",
 			' ', "0.1");
 		TCLAP::SwitchArg quick("", "quick", "smoke run with small samples (< 1 min)", cmd);
-		TCLAP::ValueArg<std::string> out("o", "out", "also write the report to this file", false, "", "FILE", cmd);
-		TCLAP::ValueArg<int> positions("", "positions", "image positions per (distance, angle) cell (default 16, quick 2)", false, 0, "N", cmd);
-		TCLAP::ValueArg<int> clutter("", "clutter", "background-only frames (default 1000, quick 30)", false, -1, "N", cmd);
-		TCLAP::ValueArg<int> scale("", "scale-frames", "frames per image size / landmark count (default 10, quick 2)", false, 0, "N", cmd);
-		TCLAP::ValueArg<std::string> revision("", "revision", "source revision to print in the report", false, "", "TEXT", cmd);
-		TCLAP::ValueArg<std::string> dump("", "dump-misses", "write codemark's missed sweep frames (PNG + true corners) into this existing directory", false, "", "DIR", cmd);
-		TCLAP::ValueArg<std::string> dump_clutter("", "dump-clutter", "write the background-only frames in which codemark examines ROIs (PNG) into this existing directory", false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> out(
+			"o", "out", "also write the report to this file", false, "", "FILE", cmd);
+		TCLAP::ValueArg<int> positions(
+			"", "positions", "image positions per (distance, angle) cell (default 16, quick 2)",
+			false, 0, "N", cmd);
+		TCLAP::ValueArg<int> clutter(
+			"", "clutter", "background-only frames (default 1000, quick 30)", false, -1, "N", cmd);
+		TCLAP::ValueArg<int> scale(
+			"", "scale-frames", "frames per image size / landmark count (default 10, quick 2)",
+			false, 0, "N", cmd);
+		TCLAP::ValueArg<std::string> revision(
+			"", "revision", "source revision to print in the report", false, "", "TEXT", cmd);
+		TCLAP::ValueArg<std::string> dump(
+			"", "dump-misses",
+			"write codemark's missed sweep frames (PNG + true corners) into this existing "
+			"directory",
+			false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> dump_clutter(
+			"", "dump-clutter",
+			"write the background-only frames in which codemark examines ROIs (PNG) into this "
+			"existing directory",
+			false, "", "DIR", cmd);
 		cmd.parse(argc, argv);
 		Config cfg;
 		cfg.quick = quick.getValue();

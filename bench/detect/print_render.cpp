@@ -31,17 +31,18 @@ namespace
 using sim::detail::Polygon2;
 using sim::detail::Polygon3;
 
-constexpr double kNearM = 1e-3;  // the renderer's near plane
+constexpr double kNearM = 1e-3;	 // the renderer's near plane
 
 using sim::detail::Rigid;
 using sim::detail::toRigid;
 
 Polygon3 faceRect(const Rigid& cam_T_face, double s0, double t0, double s1, double t1)
 {
-	return {cam_T_face * LandmarkGeometry::faceToLandmark(s0, t0),
-			cam_T_face * LandmarkGeometry::faceToLandmark(s1, t0),
-			cam_T_face * LandmarkGeometry::faceToLandmark(s1, t1),
-			cam_T_face * LandmarkGeometry::faceToLandmark(s0, t1)};
+	return {
+		cam_T_face * LandmarkGeometry::faceToLandmark(s0, t0),
+		cam_T_face * LandmarkGeometry::faceToLandmark(s1, t0),
+		cam_T_face * LandmarkGeometry::faceToLandmark(s1, t1),
+		cam_T_face * LandmarkGeometry::faceToLandmark(s0, t1)};
 }
 
 // As libs/sim's render.cpp (anonymous there).
@@ -51,7 +52,8 @@ using sim::detail::pixelBounds;
  * seen from the front, non-zero = white); the reference square is the
  * centred \a ref_cells x \a ref_cells block, whose cells are painted; a
  * white margin of one cell surrounds it. */
-PlanarPrint markerPrint(PrintKind kind, int id, const cv::Mat& cells, int ref_cells, double ref_size_m)
+PlanarPrint markerPrint(
+	PrintKind kind, int id, const cv::Mat& cells, int ref_cells, double ref_size_m)
 {
 	PlanarPrint p;
 	p.kind = kind;
@@ -59,7 +61,8 @@ PlanarPrint markerPrint(PrintKind kind, int id, const cv::Mat& cells, int ref_ce
 	const double cell = ref_size_m / ref_cells, h = 0.5 * ref_size_m;
 	p.ref_half_m = h;
 	p.sheet_half_m = h + cell;
-	p.rects.push_back({-p.sheet_half_m, -p.sheet_half_m, p.sheet_half_m, p.sheet_half_m, kWhite, 1});
+	p.rects.push_back(
+		{-p.sheet_half_m, -p.sheet_half_m, p.sheet_half_m, p.sheet_half_m, kWhite, 1});
 	p.rects.push_back({-h, -h, h, h, kWhite, -1});
 	p.rects.push_back({-h, -h, h, h, kBlack, 1});
 	const int off = (cells.rows - ref_cells) / 2;
@@ -109,9 +112,12 @@ const char* printKindName(PrintKind k)
 {
 	switch (k)
 	{
-		case PrintKind::Codemark: return "codemark";
-		case PrintKind::Aruco: return "ArUco 4x4_50";
-		default: return "AprilTag 36h11";
+		case PrintKind::Codemark:
+			return "codemark";
+		case PrintKind::Aruco:
+			return "ArUco 4x4_50";
+		default:
+			return "AprilTag 36h11";
 	}
 }
 
@@ -119,7 +125,8 @@ PlanarPrint makePrint(PrintKind kind, int id, double ref_size_m)
 {
 	if (kind == PrintKind::Aruco)
 	{
-		if (id < 0 || id >= 50) throw std::invalid_argument("DICT_4X4_50 has no ID " + std::to_string(id));
+		if (id < 0 || id >= 50)
+			throw std::invalid_argument("DICT_4X4_50 has no ID " + std::to_string(id));
 		const auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
 		cv::Mat cells;
 		cv::aruco::drawMarker(dict, id, 6, cells, 1);  // one pixel per cell
@@ -133,7 +140,8 @@ PlanarPrint makePrint(PrintKind kind, int id, double ref_size_m)
 	if (id < 0 || id > 255) throw std::invalid_argument("codemark has no ID " + std::to_string(id));
 	// Our landmark as libs/sim draws it: sheet white, frame black, green
 	// square, black code cells.
-	const LandmarkGeometry g = LandmarkGeometry::scaled(ref_size_m / LandmarkGeometry().inner_size_m);
+	const LandmarkGeometry g =
+		LandmarkGeometry::scaled(ref_size_m / LandmarkGeometry().inner_size_m);
 	PlanarPrint p;
 	p.kind = kind;
 	p.id = id;
@@ -157,13 +165,16 @@ PlanarPrint makePrint(PrintKind kind, int id, double ref_size_m)
 	return p;
 }
 
-PrintTruth truthOf(const PlacedPrint& p, const CameraModel& cam, const mrpt::poses::CPose3D& world_T_camera)
+PrintTruth truthOf(
+	const PlacedPrint& p, const CameraModel& cam, const mrpt::poses::CPose3D& world_T_camera)
 {
 	const Rigid cam_T = toRigid(p.world_T_print - world_T_camera);
-	const auto project = [&](double s, double t, bool& ok) {
+	const auto project = [&](double s, double t, bool& ok)
+	{
 		const Eigen::Vector3d q = cam_T * LandmarkGeometry::faceToLandmark(s, t);
 		ok = q.z() > kNearM;
-		return Eigen::Vector2d(cam.fx() * q.x() / q.z() + cam.cx(), cam.fy() * q.y() / q.z() + cam.cy());
+		return Eigen::Vector2d(
+			cam.fx() * q.x() / q.z() + cam.cx(), cam.fy() * q.y() / q.z() + cam.cy());
 	};
 	PrintTruth tr;
 	tr.id = p.print.id;
@@ -192,18 +203,21 @@ PrintTruth truthOf(const PlacedPrint& p, const CameraModel& cam, const mrpt::pos
 	{
 		bool in = false;
 		const Eigen::Vector2d q = project(S * face[k].x(), S * face[k].y(), in);
-		vis = in && q.x() >= 0.5 && q.x() <= cam.width() - 1.5 && q.y() >= 0.5 && q.y() <= cam.height() - 1.5;
+		vis = in && q.x() >= 0.5 && q.x() <= cam.width() - 1.5 && q.y() >= 0.5 &&
+			  q.y() <= cam.height() - 1.5;
 	}
 	tr.sheet_visible = vis;
 	return tr;
 }
 
-Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam,
+Frame renderFrame(
+	const std::vector<PlacedPrint>& prints, const CameraModel& cam,
 	const mrpt::poses::CPose3D& world_T_camera, const sim::RenderOptions& o, const Effects& fx,
 	uint64_t seed)
 {
 	if (cam.hasDistortion())
-		throw std::invalid_argument("renderFrame: the exact-coverage path needs a camera without distortion");
+		throw std::invalid_argument(
+			"renderFrame: the exact-coverage path needs a camera without distortion");
 	const int W = cam.width(), H = cam.height();
 	cv::Mat img = sim::detail::makeBackground(o, W, H, seed);  // CV_32FC3
 
@@ -216,9 +230,9 @@ Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam
 	}
 	std::vector<size_t> order(prints.size());
 	std::iota(order.begin(), order.end(), size_t(0));
-	std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-		return cam_T[a].t.norm() > cam_T[b].t.norm();
-	});
+	std::stable_sort(
+		order.begin(), order.end(),
+		[&](size_t a, size_t b) { return cam_T[a].t.norm() > cam_T[b].t.norm(); });
 
 	const auto v3 = [](const cv::Scalar& s) { return cv::Vec3d(s[0], s[1], s[2]); };
 	const std::array<cv::Vec3d, kNumPaints> col{v3(o.white_bgr), v3(o.black_bgr), v3(o.green_bgr)};
@@ -227,8 +241,10 @@ Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam
 		const PlanarPrint& pr = prints[i].print;
 		const mrpt::poses::CPose3D print_T_camera = world_T_camera - prints[i].world_T_print;
 		if (!(print_T_camera.x() > 0)) continue;  // seen from behind: the wall
-		const auto project = [&](const Polygon3& p) {
-			return sim::detail::projectPinhole(sim::detail::clipNear(p, kNearM), cam.fx(), cam.fy(), cam.cx(), cam.cy());
+		const auto project = [&](const Polygon3& p)
+		{
+			return sim::detail::projectPinhole(
+				sim::detail::clipNear(p, kNearM), cam.fx(), cam.fy(), cam.cx(), cam.cy());
 		};
 		const double S = pr.sheet_half_m;
 		const Polygon2 sheet = project(faceRect(cam_T[i], -S, -S, S, S));
@@ -240,7 +256,8 @@ Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam
 		sim::detail::accumulateCoverage(sheet, c_sheet, roi.tl());
 		for (const FaceRect& r : pr.rects)
 			sim::detail::accumulateCoverage(
-				project(faceRect(cam_T[i], r.s0, r.t0, r.s1, r.t1)), acc[r.paint], roi.tl(), r.weight);
+				project(faceRect(cam_T[i], r.s0, r.t0, r.s1, r.t1)), acc[r.paint], roi.tl(),
+				r.weight);
 		for (int y = 0; y < roi.height; ++y)
 		{
 			cv::Vec3f* px = img.ptr<cv::Vec3f>(roi.y + y) + roi.x;
@@ -252,13 +269,15 @@ Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam
 			{
 				if (c0[x] == 0) continue;
 				const cv::Vec3d bg(px[x][0], px[x][1], px[x][2]);
-				const cv::Vec3d v = bg * (1 - c0[x]) + col[kWhite] * aw[x] + col[kBlack] * ab[x] + col[kGreen] * ag[x];
+				const cv::Vec3d v = bg * (1 - c0[x]) + col[kWhite] * aw[x] + col[kBlack] * ab[x] +
+									col[kGreen] * ag[x];
 				px[x] = cv::Vec3f(float(v[0]), float(v[1]), float(v[2]));
 			}
 		}
 	}
 	if (fx.blur_sigma_px > 0)
-		cv::GaussianBlur(img, img, cv::Size(0, 0), fx.blur_sigma_px, fx.blur_sigma_px, cv::BORDER_REPLICATE);
+		cv::GaussianBlur(
+			img, img, cv::Size(0, 0), fx.blur_sigma_px, fx.blur_sigma_px, cv::BORDER_REPLICATE);
 	if (fx.noise_sigma > 0)
 	{
 		cv::RNG rng(sim::detail::streamSeed(seed, 4));
@@ -270,7 +289,8 @@ Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& cam
 	return out;
 }
 
-double checkAgainstSim(const MapLandmark& lm, const CameraModel& cam, const mrpt::poses::CPose3D& world_T_camera,
+double checkAgainstSim(
+	const MapLandmark& lm, const CameraModel& cam, const mrpt::poses::CPose3D& world_T_camera,
 	const sim::RenderOptions& background, const Effects& effects, uint64_t seed)
 {
 	sim::Scene scene;
@@ -281,7 +301,8 @@ double checkAgainstSim(const MapLandmark& lm, const CameraModel& cam, const mrpt
 	o.blur_sigma_px = effects.blur_sigma_px;
 	o.noise_sigma = effects.noise_sigma;
 	const sim::Render ref = sim::render(scene, o, seed);
-	PlacedPrint p{makePrint(PrintKind::Codemark, lm.id, lm.geometry().inner_size_m), lm.world_T_landmark()};
+	PlacedPrint p{
+		makePrint(PrintKind::Codemark, lm.id, lm.geometry().inner_size_m), lm.world_T_landmark()};
 	const Frame mine = renderFrame({p}, cam, world_T_camera, background, effects, seed);
 	cv::Mat diff;
 	cv::absdiff(ref.image, mine.bgr, diff);

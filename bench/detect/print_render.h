@@ -28,7 +28,7 @@ namespace codemark::bench
 enum class PrintKind
 {
 	Codemark,  //!< our landmark (LandmarkGeometry, ID 0..255)
-	Aruco,  //!< OpenCV ArUco DICT_4X4_50 (ID 0..49), 6 x 6 cells with its black border
+	Aruco,	//!< OpenCV ArUco DICT_4X4_50 (ID 0..49), 6 x 6 cells with its black border
 	AprilTag  //!< AprilTag 3 tag36h11 (ID 0..586), 8 x 8 cells inside its white ring
 };
 
@@ -91,14 +91,14 @@ struct PrintTruth
 	/** Whole sheet in front of the camera and at least 1 px inside the image. */
 	bool sheet_visible = false;
 	double ref_height_px = 0;  //!< vertical extent of the reference square [px]
-	double ref_side_px = 0;  //!< mean side length of the reference square [px]
+	double ref_side_px = 0;	 //!< mean side length of the reference square [px]
 };
 
 /** Post-effects applied identically to every frame: blur then noise, as
  * sim::render orders them. */
 struct Effects
 {
-	double blur_sigma_px = 0.8;  //!< Gaussian blur [px]
+	double blur_sigma_px = 0.8;	 //!< Gaussian blur [px]
 	double noise_sigma = 2.0;  //!< Gaussian noise [grey levels]
 };
 
@@ -106,12 +106,12 @@ struct Effects
 struct Frame
 {
 	cv::Mat bgr;  //!< CV_8UC3
-	std::vector<PrintTruth> truth;  //!< one per print, input order
+	std::vector<PrintTruth> truth;	//!< one per print, input order
 };
 
 /** Ground truth only (cheap). \a camera must have no lens distortion. */
-PrintTruth truthOf(const PlacedPrint& p, const CameraModel& camera,
-	const mrpt::poses::CPose3D& world_T_camera);
+PrintTruth truthOf(
+	const PlacedPrint& p, const CameraModel& camera, const mrpt::poses::CPose3D& world_T_camera);
 
 /** Renders \a prints over \a background's background (sim's
  * makeBackground with its distractors, seed \a seed), far to near by exact
@@ -119,15 +119,16 @@ PrintTruth truthOf(const PlacedPrint& p, const CameraModel& camera,
  * \a seed), rounding to 8 bits: for our landmark alone this is
  * sim::render() with the same options and seed. Throws
  * std::invalid_argument for a camera with lens distortion. */
-Frame renderFrame(const std::vector<PlacedPrint>& prints, const CameraModel& camera,
+Frame renderFrame(
+	const std::vector<PlacedPrint>& prints, const CameraModel& camera,
 	const mrpt::poses::CPose3D& world_T_camera, const sim::RenderOptions& background,
 	const Effects& effects, uint64_t seed);
 
 /** Largest absolute difference (grey levels) between renderFrame() of our
  * landmark \a lm and sim::render() of the same scene, options and seed. */
-double checkAgainstSim(const MapLandmark& lm, const CameraModel& camera,
-	const mrpt::poses::CPose3D& world_T_camera, const sim::RenderOptions& background,
-	const Effects& effects, uint64_t seed);
+double checkAgainstSim(
+	const MapLandmark& lm, const CameraModel& camera, const mrpt::poses::CPose3D& world_T_camera,
+	const sim::RenderOptions& background, const Effects& effects, uint64_t seed);
 
 const char* printKindName(PrintKind k);
 

@@ -63,7 +63,8 @@ namespace
 using Clock = std::chrono::steady_clock;
 
 /** Mean executeOn time [ms] over about \a budget_s seconds. */
-double timeUpdate(mrpt::maps::CMetricMap::Ptr map, size_t n, const mrpt::obs::CSensoryFrame& sf,
+double timeUpdate(
+	mrpt::maps::CMetricMap::Ptr map, size_t n, const mrpt::obs::CSensoryFrame& sf,
 	const mrpt::obs::CActionCollection& acts, double budget_s)
 {
 	mrpt::slam::CMonteCarloLocalization2D pdf;
@@ -72,7 +73,7 @@ double timeUpdate(mrpt::maps::CMetricMap::Ptr map, size_t n, const mrpt::obs::CS
 	mrpt::bayes::CParticleFilter pf;
 	pf.m_options.PF_algorithm = mrpt::bayes::CParticleFilter::pfStandardProposal;
 	pf.m_options.adaptiveSampleSize = false;
-	pf.m_options.BETA = 0;  // never resample: same work for both maps
+	pf.m_options.BETA = 0;	// never resample: same work for both maps
 	mrpt::bayes::CParticleFilter::TParticleFilterStats st;
 	pf.executeOn(pdf, &acts, &sf, &st);	 // warm-up
 	int reps = 0;
@@ -118,14 +119,17 @@ int main(int argc, char** argv)
 		const double budget = quick ? 0.1 : (n >= 100000 ? 3.0 : 1.0);
 		const double a = timeUpdate(ours, n, sf, acts, budget);
 		const double b = timeUpdate(flat, n, sf, acts, budget);
-		std::printf("| %zu | %.3f | %.3f | %.3f | %.2f |\n", n, a, b, 1000.0 * a / double(n), a / b);
+		std::printf(
+			"| %zu | %.3f | %.3f | %.3f | %.2f |\n", n, a, b, 1000.0 * a / double(n), a / b);
 	}
 
 	std::printf("\n## From a uniform start (shipped pf.ini)\n\n");
 	std::printf(
 		"Room 6 x 4 m, 12 landmarks, circle of radius 1 m at 0.4 m/s, 5 Hz, noisy odometry; "
 		"converged = position error < 10 cm and `estimate().initialized`.\n\n");
-	std::printf("| seed | frames with sightings to converge | final error [cm] | mean step [ms] | injections |\n");
+	std::printf(
+		"| seed | frames with sightings to converge | final error [cm] | mean step [ms] | "
+		"injections |\n");
 	std::printf("|---:|---:|---:|---:|---:|\n");
 	mrpt::config::CConfigFileMemory base(
 		mrpt::io::file_get_contents(std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/pf.ini"));
@@ -154,7 +158,9 @@ int main(int argc, char** argv)
 			err = std::hypot(e.mean.x() - t.x(), e.mean.y() - t.y());
 			if (converged_at < 0 && err < 0.10 && e.initialized) converged_at = frames;
 		}
-		std::printf("| %d | %d | %.1f | %.2f | %d |\n", seed, converged_at, 100 * err, total_ms / K, f.injections());
+		std::printf(
+			"| %d | %d | %.1f | %.2f | %d |\n", seed, converged_at, 100 * err, total_ms / K,
+			f.injections());
 	}
 	return 0;
 }

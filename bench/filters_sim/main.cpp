@@ -42,7 +42,8 @@ struct Noise
 	double noise_sigma, blur_sigma_px;
 };
 
-std::vector<RawlogStep> readSteps(const std::string& rawlog, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map)
+std::vector<RawlogStep> readSteps(
+	const std::string& rawlog, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map)
 {
 	StepperOptions so;
 	so.loadFromConfigFile(cfg, "stepper");
@@ -57,7 +58,8 @@ std::vector<RawlogStep> readSteps(const std::string& rawlog, const mrpt::config:
 	return steps;
 }
 
-LocalizeSummary runSteps(const std::vector<RawlogStep>& steps, const std::string& method,
+LocalizeSummary runSteps(
+	const std::vector<RawlogStep>& steps, const std::string& method,
 	const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map, const sim::DatasetSummary& ds)
 {
 	LocalizeSummary s;
@@ -95,8 +97,9 @@ LocalizeSummary runSteps(const std::vector<RawlogStep>& steps, const std::string
 void costTable(const std::string& share)
 {
 	std::printf("\n### EKF time per step against the landmarks in view\n\n");
-	std::printf("Synthetic frames (no images): n landmarks on a 3 m circle around the robot, "
-				"2000 steps each, one Kalman iteration per landmark (FEAT = 0).\n\n");
+	std::printf(
+		"Synthetic frames (no images): n landmarks on a 3 m circle around the robot, "
+		"2000 steps each, one Kalman iteration per landmark (FEAT = 0).\n\n");
 	std::printf("| landmarks in view | ekf [us/step] | ekf-pose [us/step] |\n|---:|---:|---:|\n");
 	for (int n : {1, 2, 4, 8, 16, 32})
 	{
@@ -116,14 +119,16 @@ void costTable(const std::string& share)
 			init.initialized = true;
 			init.cov = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
 			auto f = makeEkfLocalizer(kind, EkfOptions(), map, init);
-			const auto cam = mrpt::poses::CPose3D(0, 0, 0.6, 0, 0, 0) + mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+			const auto cam = mrpt::poses::CPose3D(0, 0, 0.6, 0, 0, 0) +
+							 mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 			auto obs = CObservationCodedLandmarks::Create();
 			obs->cameraPose = cam;
 			for (const auto& l : map.landmarks)
 			{
 				CObservationCodedLandmarks::TSighting s;
 				s.id = l.id;
-				s.L = predictLandmarkMeasurement(Eigen::Vector3d::Zero(), pose::cameraPlanarPose(cam),
+				s.L = predictLandmarkMeasurement(
+					Eigen::Vector3d::Zero(), pose::cameraPlanarPose(cam),
 					pose::landmarkPlanarPose(l.world_T_landmark()));
 				s.C_L = Eigen::Vector3d(1e-4, 1e-6, 1e-4).asDiagonal();
 				Eigen::Matrix3d J;
@@ -141,7 +146,8 @@ void costTable(const std::string& share)
 			const int N = 2000;
 			const auto t0 = Clock::now();
 			for (int k = 0; k < N; ++k) f->step(&odo, sf);
-			std::printf(" | %.1f", 1e6 * std::chrono::duration<double>(Clock::now() - t0).count() / N);
+			std::printf(
+				" | %.1f", 1e6 * std::chrono::duration<double>(Clock::now() - t0).count() / N);
 		}
 		std::printf(" |\n");
 	}
@@ -153,12 +159,20 @@ int main(int argc, char** argv)
 {
 	try
 	{
-		TCLAP::CmdLine cmd("Benchmarks codemark's filters on simulated datasets (Markdown on stdout).", ' ', "0.1");
-		TCLAP::ValueArg<std::string> work("w", "work", "folder for the datasets", false, "/tmp/codemark_bench_filters", "DIR", cmd);
-		TCLAP::ValueArg<std::string> share("s", "share", "share/codemark folder", false, CODEMARK_SOURCE_SHARE_DIR, "DIR", cmd);
+		TCLAP::CmdLine cmd(
+			"Benchmarks codemark's filters on simulated datasets (Markdown on stdout).", ' ',
+			"0.1");
+		TCLAP::ValueArg<std::string> work(
+			"w", "work", "folder for the datasets", false, "/tmp/codemark_bench_filters", "DIR",
+			cmd);
+		TCLAP::ValueArg<std::string> share(
+			"s", "share", "share/codemark folder", false, CODEMARK_SOURCE_SHARE_DIR, "DIR", cmd);
 		TCLAP::ValueArg<int> seeds("n", "seeds", "number of seeds", false, 3, "N", cmd);
-		TCLAP::ValueArg<int> frames("f", "max-frames", "frames per dataset (0: the whole loop)", false, 0, "N", cmd);
-		TCLAP::ValueArg<std::string> methods("m", "methods", "comma-separated methods", false, "ekf,ekf-pose,ekf-slam,pf", "LIST", cmd);
+		TCLAP::ValueArg<int> frames(
+			"f", "max-frames", "frames per dataset (0: the whole loop)", false, 0, "N", cmd);
+		TCLAP::ValueArg<std::string> methods(
+			"m", "methods", "comma-separated methods", false, "ekf,ekf-pose,ekf-slam,pf", "LIST",
+			cmd);
 		cmd.parse(argc, argv);
 
 		std::vector<std::string> ms;
@@ -166,7 +180,8 @@ int main(int argc, char** argv)
 			std::stringstream ss(methods.getValue());
 			for (std::string m; std::getline(ss, m, ',');) ms.push_back(m);
 		}
-		const std::vector<Noise> noises = {{"noise 2, blur 0.8 px", 2.0, 0.8}, {"noise 6, blur 1.2 px", 6.0, 1.2}};
+		const std::vector<Noise> noises = {
+			{"noise 2, blur 0.8 px", 2.0, 0.8}, {"noise 6, blur 1.2 px", 6.0, 1.2}};
 		std::map<std::pair<std::string, std::string>, Result> results;
 		std::map<std::string, std::string> skipped;
 		for (const auto& nz : noises)
@@ -177,7 +192,9 @@ int main(int argc, char** argv)
 				o.seed = seed;
 				o.render.noise_sigma = nz.noise_sigma;
 				o.render.blur_sigma_px = nz.blur_sigma_px;
-				const auto dir = fs::path(work.getValue()) / ("seed" + std::to_string(seed) + "_noise" + std::to_string(int(nz.noise_sigma)));
+				const auto dir =
+					fs::path(work.getValue()) / ("seed" + std::to_string(seed) + "_noise" +
+												 std::to_string(int(nz.noise_sigma)));
 				std::fprintf(stderr, "filters_sim: dataset %s\n", dir.c_str());
 				fs::create_directories(dir);
 				const auto ds = sim::writeDataset(o, dir.string(), false, {}, frames.getValue());
@@ -191,7 +208,8 @@ int main(int argc, char** argv)
 						continue;
 					}
 					mrpt::config::CConfigFile cfg(ini);
-					if (steps.empty()) steps = readSteps((dir / "dataset.rawlog").string(), cfg, ds.map);
+					if (steps.empty())
+						steps = readSteps((dir / "dataset.rawlog").string(), cfg, ds.map);
 					auto& r = results[{nz.name, m}];
 					try
 					{
@@ -207,7 +225,7 @@ int main(int argc, char** argv)
 						r.yaw += s.metrics->yaw_rmse_deg;
 						r.nees += s.metrics->nees_mean;
 						r.nees_in_band += s.metrics->nees_mean >= s.metrics->nees_band_low &&
-							s.metrics->nees_mean <= s.metrics->nees_band_high;
+										  s.metrics->nees_mean <= s.metrics->nees_band_high;
 						r.first_fix_s += s.first_fix_time_s;
 						r.ms += s.time_per_step_ms;
 						r.used += s.sightings_used;
@@ -221,25 +239,32 @@ int main(int argc, char** argv)
 				}
 			}
 		std::printf("### Simulated room loops with images\n\n");
-		std::printf("codemark-simul's default room (6 x 4 m, 12 landmarks), one loop, 5 Hz images detected "
-					"on the fly, odometry with MRPT's Gaussian model and a 3%% scale error, "
-					"actions-observations format; %d seeds per image-noise level; every filter starts with "
-					"no initial pose (global initialisation) and reads its shipped ini "
-					"(share/codemark/config/<method>.ini). Means over the seeds; max error is the largest "
-					"over the seeds. NEES in band: runs whose mean NEES lies in the two-sided 95%% "
-					"chi-square band (3 DoF).\n\n", seeds.getValue());
-		std::printf("| images | method | ATE [m] | max error [m] | yaw RMSE [deg] | mean NEES | NEES in band | "
-					"first fix [s] | used / rejected sightings | time per step [ms] |\n");
+		std::printf(
+			"codemark-simul's default room (6 x 4 m, 12 landmarks), one loop, 5 Hz images detected "
+			"on the fly, odometry with MRPT's Gaussian model and a 3%% scale error, "
+			"actions-observations format; %d seeds per image-noise level; every filter starts with "
+			"no initial pose (global initialisation) and reads its shipped ini "
+			"(share/codemark/config/<method>.ini). Means over the seeds; max error is the largest "
+			"over the seeds. NEES in band: runs whose mean NEES lies in the two-sided 95%% "
+			"chi-square band (3 DoF).\n\n",
+			seeds.getValue());
+		std::printf(
+			"| images | method | ATE [m] | max error [m] | yaw RMSE [deg] | mean NEES | NEES in "
+			"band | "
+			"first fix [s] | used / rejected sightings | time per step [ms] |\n");
 		std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
 		for (const auto& [key, r] : results)
 		{
 			const int ok = r.runs - r.failed;
 			if (ok <= 0) continue;
-			std::printf("| %s | %s | %.4f | %.4f | %.3f | %.2f | %d/%d | %.2f | %ld / %ld | %.3f |\n", key.first.c_str(),
-				key.second.c_str(), r.ate / ok, r.max_err, r.yaw / ok, r.nees / ok, r.nees_in_band, r.runs,
-				r.first_fix_s / ok, r.used, r.rejected, r.ms / ok);
+			std::printf(
+				"| %s | %s | %.4f | %.4f | %.3f | %.2f | %d/%d | %.2f | %ld / %ld | %.3f |\n",
+				key.first.c_str(), key.second.c_str(), r.ate / ok, r.max_err, r.yaw / ok,
+				r.nees / ok, r.nees_in_band, r.runs, r.first_fix_s / ok, r.used, r.rejected,
+				r.ms / ok);
 		}
-		for (const auto& [m, why] : skipped) std::printf("\n%s not run: %s\n", m.c_str(), why.c_str());
+		for (const auto& [m, why] : skipped)
+			std::printf("\n%s not run: %s\n", m.c_str(), why.c_str());
 		costTable(share.getValue());
 		return 0;
 	}

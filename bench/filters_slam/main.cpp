@@ -75,8 +75,7 @@ double rmsePath(const std::vector<Eigen::Vector2d>& est, const std::vector<Eigen
 	return n ? std::sqrt(s / n) : NAN;
 }
 
-void landmarkErrors(
-	const std::map<int, Eigen::Vector2d>& est, const LandmarkMap& gt, Result& r)
+void landmarkErrors(const std::map<int, Eigen::Vector2d>& est, const LandmarkMap& gt, Result& r)
 {
 	double s = 0, m = 0;
 	std::size_t n = 0;
@@ -122,7 +121,8 @@ Result runOurs(
 		lms[m.landmark.id] = Eigen::Vector2d(m.landmark.x_m, m.landmark.y_m);
 	landmarkErrors(lms, gt_map, r);
 	r.step_ms = total / std::max<std::size_t>(1, r.steps);
-	r.kf_ms = slam.meanKalmanIterationMs() * slam.kalmanIterations() / std::max<std::size_t>(1, r.steps);
+	r.kf_ms =
+		slam.meanKalmanIterationMs() * slam.kalmanIterations() / std::max<std::size_t>(1, r.steps);
 	return r;
 }
 
@@ -216,7 +216,7 @@ void scaling(int n, unsigned seed, const std::string& method, double& step_ms, d
 	// A level camera 0.2 m ahead of the robot centre looking 1 rad to the
 	// right, towards the ring (the robot drives counter-clockwise).
 	const mrpt::poses::CPose3D cam_pose = mrpt::poses::CPose3D(0.2, 0, 0.5, -1.0, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+										  mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	const mrpt::poses::CPose2D cam2d(0.2, 0, -1.0);
 	const int per_lap = 400;
 	const double dth = 2 * M_PI / per_lap, ds = R_robot * dth;
@@ -289,7 +289,8 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> config(
 			"", "config", "codemark ekf-slam.ini", true, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> kfslam(
-			"", "kf-slam-ini", "stock kf-slam ini (for CRangeBearingKFSLAM2D)", true, "", "FILE", cmd);
+			"", "kf-slam-ini", "stock kf-slam ini (for CRangeBearingKFSLAM2D)", true, "", "FILE",
+			cmd);
 		TCLAP::ValueArg<int> reps("", "reps", "timing repetitions (best kept)", false, 5, "N", cmd);
 		TCLAP::ValueArg<std::string> sizes(
 			"", "sizes", "map sizes for the scaling run, comma separated", false, "10,50,256",
@@ -321,8 +322,8 @@ int main(int argc, char** argv)
 					best = std::min(best, ms);
 				}
 				std::printf(
-					"scaling_%d_%s_step_ms = %.4f\nscaling_%d_visible = %.2f\n", n, method, best,
-					n, vis);
+					"scaling_%d_%s_step_ms = %.4f\nscaling_%d_visible = %.2f\n", n, method, best, n,
+					vis);
 			}
 		}
 		return 0;

@@ -31,7 +31,7 @@ namespace
 struct Sample
 {
 	double d, angle_deg;
-	double side_px;  // apparent height y1 + y2 (true) [px]
+	double side_px;	 // apparent height y1 + y2 (true) [px]
 	double width_px;  // apparent width x2 - x1 (true) [px]
 	Eigen::Matrix<double, 8, 1> e_corner;  // (u, v) errors TL TR BR BL [px]
 	Eigen::Vector4d e_P;
@@ -42,19 +42,30 @@ int main(int argc, char** argv)
 {
 	try
 	{
-		TCLAP::CmdLine cmd("Detector corner and P errors on renders (calibration data of C_P).", ' ', "0.1.0");
-		TCLAP::ValueArg<int> n_arg("", "renders", "Number of renders. Default 2000.", false, 2000, "N", cmd);
-		TCLAP::ValueArg<double> dmin_arg("", "min-distance", "Nearest [m]. Default 0.5.", false, 0.5, "M", cmd);
-		TCLAP::ValueArg<double> dmax_arg("", "max-distance", "Farthest [m]. Default 5.", false, 5.0, "M", cmd);
-		TCLAP::ValueArg<double> amax_arg("", "max-angle", "Largest view angle [deg]. Default 70.", false, 70, "DEG", cmd);
+		TCLAP::CmdLine cmd(
+			"Detector corner and P errors on renders (calibration data of C_P).", ' ', "0.1.0");
+		TCLAP::ValueArg<int> n_arg(
+			"", "renders", "Number of renders. Default 2000.", false, 2000, "N", cmd);
+		TCLAP::ValueArg<double> dmin_arg(
+			"", "min-distance", "Nearest [m]. Default 0.5.", false, 0.5, "M", cmd);
+		TCLAP::ValueArg<double> dmax_arg(
+			"", "max-distance", "Farthest [m]. Default 5.", false, 5.0, "M", cmd);
+		TCLAP::ValueArg<double> amax_arg(
+			"", "max-angle", "Largest view angle [deg]. Default 70.", false, 70, "DEG", cmd);
 		TCLAP::ValueArg<unsigned long> seed_arg("", "seed", "Seed. Default 1.", false, 1, "N", cmd);
-		TCLAP::ValueArg<double> bearing_arg("", "max-bearing", "Largest |phi1| [rad]. Default 0.15.", false, 0.15, "RAD", cmd);
-		TCLAP::ValueArg<double> height_arg("", "max-height", "Largest |camera height - landmark centre height| [m]. Default 0.2.", false, 0.2, "M", cmd);
-		TCLAP::SwitchArg realistic_arg("", "realistic",
+		TCLAP::ValueArg<double> bearing_arg(
+			"", "max-bearing", "Largest |phi1| [rad]. Default 0.15.", false, 0.15, "RAD", cmd);
+		TCLAP::ValueArg<double> height_arg(
+			"", "max-height", "Largest |camera height - landmark centre height| [m]. Default 0.2.",
+			false, 0.2, "M", cmd);
+		TCLAP::SwitchArg realistic_arg(
+			"", "realistic",
 			"Render as the simulated datasets do (sim::DatasetOptions::realisticRender(): textured "
-			"wall, light gradient, noise 2, blur 0.8) instead of the accuracy map's flat background.",
+			"wall, light gradient, noise 2, blur 0.8) instead of the accuracy map's flat "
+			"background.",
 			cmd, false);
-		TCLAP::ValueArg<std::string> csv_arg("", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> csv_arg(
+			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
 
@@ -82,7 +93,8 @@ int main(int argc, char** argv)
 			const double a = (2 * U(rng) - 1) * amax_arg.getValue();
 			const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue(),
 						 height = (2 * U(rng) - 1) * height_arg.getValue();
-			scene.world_T_camera = sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
+			scene.world_T_camera =
+				sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
 			const sim::Render img = sim::render(scene, ro, seed_arg.getValue() * 100003 + i);
 			if (!img.truth[0].fully_visible) continue;
 			const auto res = detect::detect(img.image, scene.camera, g, dopt);
@@ -96,7 +108,8 @@ int main(int argc, char** argv)
 					s.side_px = img.truth[0].P[1] + img.truth[0].P[3];
 					s.width_px = img.truth[0].P[2] - img.truth[0].P[0];
 					for (int k = 0; k < 4; ++k)
-						s.e_corner.segment<2>(2 * k) = dl.detection.corners[k] - img.truth[0].corners_px[k];
+						s.e_corner.segment<2>(2 * k) =
+							dl.detection.corners[k] - img.truth[0].corners_px[k];
 					s.e_P = primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
 					samples.push_back(s);
 					found = true;
@@ -107,7 +120,8 @@ int main(int argc, char** argv)
 		if (!csv_arg.getValue().empty())
 		{
 			std::ofstream f(csv_arg.getValue());
-			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2\n";
+			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
+				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
@@ -129,7 +143,8 @@ int main(int argc, char** argv)
 			double nll = 1e300, floor = 0, growth = 0, exponent = 0;
 		};
 		const auto sizeOf = [](const Sample& s, bool x) { return x ? s.width_px : s.side_px; };
-		const auto fit = [&](bool x) {
+		const auto fit = [&](bool x)
+		{
 			Fit best;
 			for (int i = 1; i <= 16; ++i)
 				for (int j = 1; j <= 40; ++j)
@@ -141,7 +156,8 @@ int main(int argc, char** argv)
 						{
 							const double g = gr * std::pow(ref / sizeOf(s, x), ex);
 							const double v = fl * fl + g * g;
-							for (const int c : {x ? 0 : 1, x ? 2 : 3}) nll += s.e_P[c] * s.e_P[c] / v + std::log(v);
+							for (const int c : {x ? 0 : 1, x ? 2 : 3})
+								nll += s.e_P[c] * s.e_P[c] / v + std::log(v);
 						}
 						if (nll < best.nll) best = {nll, fl, gr, ex};
 					}
@@ -151,7 +167,8 @@ int main(int argc, char** argv)
 		double cxx = 0, cyy = 0, c12x = 0, c12y = 0;
 		for (const auto& s : samples)
 		{
-			const auto sig = [&](const Fit& f, double size) {
+			const auto sig = [&](const Fit& f, double size)
+			{
 				const double g = f.growth * std::pow(ref / size, f.exponent);
 				return std::sqrt(f.floor * f.floor + g * g);
 			};
@@ -165,7 +182,8 @@ int main(int argc, char** argv)
 		// The correlation of the two edges' errors, separately for the floor
 		// term (a common shift of the inner edges, large landmarks) and the
 		// growth term (small landmarks), by maximum likelihood on a grid.
-		const auto fitCorr = [&](const Fit& f, bool x, double& r_floor, double& r_growth) {
+		const auto fitCorr = [&](const Fit& f, bool x, double& r_floor, double& r_growth)
+		{
 			double best = 1e300;
 			for (int i = -19; i <= 19; ++i)
 				for (int j = -19; j <= 19; ++j)
@@ -175,7 +193,8 @@ int main(int argc, char** argv)
 					for (const auto& s : samples)
 					{
 						const double g = f.growth * std::pow(ref / sizeOf(s, x), f.exponent);
-						const double v = f.floor * f.floor + g * g, c = rf * f.floor * f.floor + rg * g * g;
+						const double v = f.floor * f.floor + g * g,
+									 c = rf * f.floor * f.floor + rg * g * g;
 						const double det = v * v - c * c;
 						const double e1 = s.e_P[x ? 0 : 1], e2 = s.e_P[x ? 2 : 3];
 						nll += (v * e1 * e1 - 2 * c * e1 * e2 + v * e2 * e2) / det + std::log(det);
@@ -192,14 +211,23 @@ int main(int argc, char** argv)
 		fitCorr(fx, true, rfx, rgx);
 		fitCorr(fy, false, rfy, rgy);
 		std::printf("\nfit (size reference %.0f px, %zu detections):\n", ref, samples.size());
-		std::printf("  correlation of the two edges' errors: x floor %+.2f growth %+.2f; y floor %+.2f growth %+.2f\n",
+		std::printf(
+			"  correlation of the two edges' errors: x floor %+.2f growth %+.2f; y floor %+.2f "
+			"growth %+.2f\n",
 			rfx, rgx, rfy, rgy);
-		std::printf("  x1, x2: sigma_px %.4f growth_x_px %.3f size_exponent_x %.2f; normalised variance %.3f, corr_x12 %+.3f\n",
-			fx.floor, fx.growth, fx.exponent, cxx / samples.size(), c12x / samples.size() / (cxx / samples.size()));
-		std::printf("  y1, y2: sigma_y_px %.4f growth_y_px %.3f size_exponent_y %.2f; normalised variance %.3f, corr_y12 %+.3f\n",
-			fy.floor, fy.growth, fy.exponent, cyy / samples.size(), c12y / samples.size() / (cyy / samples.size()));
-		std::printf("%-9s %5s %7s | %7s %7s | %7s %7s %7s %7s | %6s %6s %6s\n", "band", "n", "side", "rms_u",
-			"rms_v", "sd_x1", "sd_y1", "sd_x2", "sd_y2", "r_y1y2", "r_x1x2", "r_uTB");
+		std::printf(
+			"  x1, x2: sigma_px %.4f growth_x_px %.3f size_exponent_x %.2f; normalised variance "
+			"%.3f, corr_x12 %+.3f\n",
+			fx.floor, fx.growth, fx.exponent, cxx / samples.size(),
+			c12x / samples.size() / (cxx / samples.size()));
+		std::printf(
+			"  y1, y2: sigma_y_px %.4f growth_y_px %.3f size_exponent_y %.2f; normalised variance "
+			"%.3f, corr_y12 %+.3f\n",
+			fy.floor, fy.growth, fy.exponent, cyy / samples.size(),
+			c12y / samples.size() / (cyy / samples.size()));
+		std::printf(
+			"%-9s %5s %7s | %7s %7s | %7s %7s %7s %7s | %6s %6s %6s\n", "band", "n", "side",
+			"rms_u", "rms_v", "sd_x1", "sd_y1", "sd_x2", "sd_y2", "r_y1y2", "r_x1x2", "r_uTB");
 		for (double lo = 0.5; lo < dmax_arg.getValue() - 1e-9; lo += 0.5)
 		{
 			const double hi = lo + 0.5;
@@ -226,10 +254,14 @@ int main(int argc, char** argv)
 			}
 			// Correlation of the u errors of the two ends of a vertical edge
 			// (TL-BL and TR-BR): one line fit's ends.
-			const double r_uTB = 0.5 * (Cc(0, 6) / std::sqrt(Cc(0, 0) * Cc(6, 6)) + Cc(2, 4) / std::sqrt(Cc(2, 2) * Cc(4, 4)));
-			std::printf("%3.1f-%3.1f m %5d %7.1f | %7.4f %7.4f | %7.4f %7.4f %7.4f %7.4f | %6.2f %6.2f %6.2f\n", lo, hi, n,
-				side / n, std::sqrt(ru), std::sqrt(rv), std::sqrt(CP(0, 0)), std::sqrt(CP(1, 1)),
-				std::sqrt(CP(2, 2)), std::sqrt(CP(3, 3)), CP(1, 3) / std::sqrt(CP(1, 1) * CP(3, 3)),
+			const double r_uTB = 0.5 * (Cc(0, 6) / std::sqrt(Cc(0, 0) * Cc(6, 6)) +
+										Cc(2, 4) / std::sqrt(Cc(2, 2) * Cc(4, 4)));
+			std::printf(
+				"%3.1f-%3.1f m %5d %7.1f | %7.4f %7.4f | %7.4f %7.4f %7.4f %7.4f | %6.2f %6.2f "
+				"%6.2f\n",
+				lo, hi, n, side / n, std::sqrt(ru), std::sqrt(rv), std::sqrt(CP(0, 0)),
+				std::sqrt(CP(1, 1)), std::sqrt(CP(2, 2)), std::sqrt(CP(3, 3)),
+				CP(1, 3) / std::sqrt(CP(1, 1) * CP(3, 3)),
 				CP(0, 2) / std::sqrt(CP(0, 0) * CP(2, 2)), r_uTB);
 		}
 		return 0;

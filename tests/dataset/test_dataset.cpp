@@ -25,7 +25,8 @@ namespace
 std::string tempDir(const std::string& name)
 {
 	// One folder per process: ctest runs tests in parallel processes.
-	const std::string d = ::testing::TempDir() + "codemark_dataset_" + std::to_string(getpid()) + "_" + name;
+	const std::string d =
+		::testing::TempDir() + "codemark_dataset_" + std::to_string(getpid()) + "_" + name;
 	mrpt::system::deleteFilesInDirectory(d, true);
 	return d;
 }
@@ -84,7 +85,7 @@ TEST(Dataset, LoopIsClosedAndSmooth)
 		const auto d = loop[i].pose - loop[i - 1].pose;
 		EXPECT_NEAR(d.norm(), step, 0.01 * step + 1e-9) << i;
 		EXPECT_LT(std::abs(d.phi()), step / o.corner_radius_m + 1e-9);
-		EXPECT_NEAR(loop[i].t - loop[i - 1].t, 0.1, 1e-6);  // UNIX times: ulp 2.4e-7 s
+		EXPECT_NEAR(loop[i].t - loop[i - 1].t, 0.1, 1e-6);	// UNIX times: ulp 2.4e-7 s
 	}
 	EXPECT_LT((loop.back().pose - loop.front().pose).norm(), step + 1e-9);
 }
@@ -116,7 +117,7 @@ TEST(Dataset, ActionsObservationsRawlog)
 		EXPECT_EQ(img->sensorLabel, "CAM");
 		EXPECT_NEAR(mrpt::Clock::toDouble(img->timestamp), gt[k][0], 1e-6);
 		EXPECT_TRUE(img->image.isExternallyStored());
-		EXPECT_EQ(img->image.getWidth(), 640u);  // loads the external file
+		EXPECT_EQ(img->image.getWidth(), 640u);	 // loads the external file
 		EXPECT_DOUBLE_EQ(img->cameraParams.fx(), 800);
 	}
 	EXPECT_EQ(LandmarkMap::load(dir + "/map.txt").landmarks.size(), 12u);
@@ -161,7 +162,8 @@ TEST(Dataset, DeterministicForASeed)
 	const auto a = tempDir("da"), b = tempDir("db");
 	writeDataset(o, a, false, {}, 5);
 	writeDataset(o, b, false, {}, 5);
-	auto slurp = [](const std::string& p) {
+	auto slurp = [](const std::string& p)
+	{
 		std::ifstream f(p, std::ios::binary);
 		std::stringstream s;
 		s << f.rdbuf();
@@ -169,7 +171,8 @@ TEST(Dataset, DeterministicForASeed)
 	};
 	EXPECT_EQ(slurp(a + "/gt_path.txt"), slurp(b + "/gt_path.txt"));
 	EXPECT_EQ(slurp(a + "/dataset.rawlog"), slurp(b + "/dataset.rawlog"));
-	EXPECT_EQ(slurp(a + "/dataset_Images/CAM_000004.png"), slurp(b + "/dataset_Images/CAM_000004.png"));
+	EXPECT_EQ(
+		slurp(a + "/dataset_Images/CAM_000004.png"), slurp(b + "/dataset_Images/CAM_000004.png"));
 	o.seed = 4;
 	const auto c = tempDir("dc");
 	writeDataset(o, c, false, {}, 5);

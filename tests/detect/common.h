@@ -43,7 +43,8 @@ inline Shot shoot(
 	MapLandmark lm;
 	lm.id = id;
 	s.scene.map.landmarks.push_back(lm);
-	s.scene.world_T_camera = sim::levelCameraLookingAt(lm, distance_m, angle_rad, height_m, bearing_rad);
+	s.scene.world_T_camera =
+		sim::levelCameraLookingAt(lm, distance_m, angle_rad, height_m, bearing_rad);
 	s.render = sim::render(s.scene, o, seed);
 	return s;
 }
@@ -69,9 +70,11 @@ inline void paintFace(
 	const std::array<Eigen::Vector2d, 4>& face_pts, const cv::Scalar& colour)
 {
 	const double h = g.innerHalf();
-	std::vector<cv::Point2f> src = {{float(-h), float(h)}, {float(h), float(h)}, {float(h), float(-h)}, {float(-h), float(-h)}};
+	std::vector<cv::Point2f> src = {
+		{float(-h), float(h)}, {float(h), float(h)}, {float(h), float(-h)}, {float(-h), float(-h)}};
 	std::vector<cv::Point2f> dst;
-	for (int k = 0; k < 4; ++k) dst.emplace_back(float(t.corners_ideal_px[k].x()), float(t.corners_ideal_px[k].y()));
+	for (int k = 0; k < 4; ++k)
+		dst.emplace_back(float(t.corners_ideal_px[k].x()), float(t.corners_ideal_px[k].y()));
 	const cv::Mat H = cv::getPerspectiveTransform(src, dst);
 	std::vector<cv::Point2f> in, out;
 	for (const auto& p : face_pts) in.emplace_back(float(p.x()), float(p.y()));
@@ -87,7 +90,8 @@ inline void paintCell(cv::Mat& img, const sim::LandmarkTruth& t, int row, int co
 	const LandmarkGeometry g;
 	const Eigen::Vector2d c = g.cellCentreFace(row, col);
 	const double a = 0.5 * g.cell_size_m;
-	paintFace(img, t, g,
+	paintFace(
+		img, t, g,
 		{Eigen::Vector2d(c.x() - a, c.y() + a), Eigen::Vector2d(c.x() + a, c.y() + a),
 		 Eigen::Vector2d(c.x() + a, c.y() - a), Eigen::Vector2d(c.x() - a, c.y() - a)},
 		black ? cv::Scalar(25, 25, 25) : cv::Scalar(0, 255, 0));

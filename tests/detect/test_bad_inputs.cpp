@@ -22,7 +22,8 @@ namespace
 {
 DetectionResult run(const cv::Mat& img)
 {
-	return codemark::detect::detect(img, CameraModel::paperDefault(), LandmarkGeometry(), DetectorOptions());
+	return codemark::detect::detect(
+		img, CameraModel::paperDefault(), LandmarkGeometry(), DetectorOptions());
 }
 
 /** The detector throws std::invalid_argument with a message naming the
@@ -36,7 +37,8 @@ void expectErrorOrNothing(const cv::Mat& img, const std::string& what)
 	}
 	catch (const std::invalid_argument& e)
 	{
-		EXPECT_NE(std::string(e.what()).find("CV_8UC3"), std::string::npos) << what << ": " << e.what();
+		EXPECT_NE(std::string(e.what()).find("CV_8UC3"), std::string::npos)
+			<< what << ": " << e.what();
 	}
 }
 }  // namespace
@@ -71,14 +73,18 @@ TEST(BadInputs, HugeFrameIsProcessed)
 
 TEST(BadInputs, AppPrintsOneErrorLinePerBadInputAndFailsAtTheEnd)
 {
-	const fs::path dir = fs::temp_directory_path() / ("codemark_detect_bad_" + std::to_string(getpid()));
+	const fs::path dir =
+		fs::temp_directory_path() / ("codemark_detect_bad_" + std::to_string(getpid()));
 	fs::remove_all(dir);
 	fs::create_directories(dir);
 	const cv::Mat green(48, 64, CV_8UC3, cv::Scalar(0, 255, 0));
 	ASSERT_TRUE(cv::imwrite((dir / "good.png").string(), green));
-	ASSERT_TRUE(cv::imwrite((dir / "tiny.png").string(), cv::Mat(1, 1, CV_8UC3, cv::Scalar(0, 255, 0))));
-	ASSERT_TRUE(cv::imwrite((dir / "grey.png").string(), cv::Mat(48, 64, CV_8UC1, cv::Scalar(128))));
-	ASSERT_TRUE(cv::imwrite((dir / "deep.png").string(), cv::Mat(48, 64, CV_16UC3, cv::Scalar(0, 65535, 0))));
+	ASSERT_TRUE(
+		cv::imwrite((dir / "tiny.png").string(), cv::Mat(1, 1, CV_8UC3, cv::Scalar(0, 255, 0))));
+	ASSERT_TRUE(
+		cv::imwrite((dir / "grey.png").string(), cv::Mat(48, 64, CV_8UC1, cv::Scalar(128))));
+	ASSERT_TRUE(cv::imwrite(
+		(dir / "deep.png").string(), cv::Mat(48, 64, CV_16UC3, cv::Scalar(0, 65535, 0))));
 	cv::Mat bgra;
 	cv::cvtColor(green, bgra, cv::COLOR_BGR2BGRA);
 	ASSERT_TRUE(cv::imwrite((dir / "alpha.png").string(), bgra));
@@ -87,7 +93,9 @@ TEST(BadInputs, AppPrintsOneErrorLinePerBadInputAndFailsAtTheEnd)
 	const std::string out = (dir / "out.jsonl").string();
 	std::ostringstream cmd;
 	cmd << "'" << CODEMARK_DETECT_APP << "'";
-	for (const char* f : {"good.png", "text.png", "tiny.png", "grey.png", "missing.png", "deep.png", "alpha.png", "empty.jpg"})
+	for (const char* f :
+		 {"good.png", "text.png", "tiny.png", "grey.png", "missing.png", "deep.png", "alpha.png",
+		  "empty.jpg"})
 		cmd << " '" << (dir / f).string() << "'";
 	cmd << " > '" << out << "' 2> /dev/null";
 	const int rc = std::system(cmd.str().c_str());

@@ -24,7 +24,8 @@ constexpr double kCornerTolPx = 0.3;
 constexpr double kFarObliqueTolPx = 0.6;
 
 /** Renders one landmark and checks it is found, with its ID and corners. */
-void expectFound(const std::string& what, int id, double dist, double angle_rad, const sim::RenderOptions& o,
+void expectFound(
+	const std::string& what, int id, double dist, double angle_rad, const sim::RenderOptions& o,
 	uint64_t seed, double bearing = 0, double height = 0, double tol = kCornerTolPx)
 {
 	const Shot s = shoot(id, dist, angle_rad, o, seed, bearing, height);
@@ -55,7 +56,8 @@ TEST(Renders, Distance0p5To5m)
 	for (double d = 0.5; d <= 5.001; d += 0.25)
 		for (int k = 0; k < 3; ++k, ++n)
 			// Off-centre by up to a quarter of the field of view where it fits.
-			expectFound(label("distance", d, n), (n * 37) % 256, d, 0, nominalRender(), n,
+			expectFound(
+				label("distance", d, n), (n * 37) % 256, d, 0, nominalRender(), n,
 				d < 1 ? 0 : (k - 1) * 0.1 * std::min(1.0, d / 2), d < 1 ? 0 : 0.05 * (k - 1));
 	EXPECT_GE(n, 57);
 }
@@ -67,7 +69,9 @@ TEST(Renders, ViewAngle0To60Deg)
 		for (int sign : {-1, 1})
 		{
 			const double d = n % 2 ? 1.0 : 2.5;
-			expectFound(label("angle_deg", sign * a, n), (n * 53 + 1) % 256, d, sign * a * kDeg, nominalRender(), 100 + n);
+			expectFound(
+				label("angle_deg", sign * a, n), (n * 53 + 1) % 256, d, sign * a * kDeg,
+				nominalRender(), 100 + n);
 			++n;
 		}
 	EXPECT_GE(n, 26);
@@ -84,8 +88,9 @@ TEST(Renders, IlluminationGainWithGradient)
 				o.gain = gain;
 				o.gradient = gradient;
 				o.gradient_angle_rad = n * 0.7;
-				expectFound(label("gain", gain, n), (n * 71 + 5) % 256, 2.0, angle * kDeg, o, 200 + n, 0.1, 0,
-					kCornerTolPx);
+				expectFound(
+					label("gain", gain, n), (n * 71 + 5) % 256, 2.0, angle * kDeg, o, 200 + n, 0.1,
+					0, kCornerTolPx);
 				++n;
 			}
 	EXPECT_EQ(n, 32);
@@ -99,7 +104,8 @@ TEST(Renders, NoiseUpTo5)
 		{
 			auto o = nominalRender();
 			o.noise_sigma = sigma;
-			expectFound(label("noise", sigma, n), (n * 29 + 7) % 256, 1.0 + k, 20.0 * k * kDeg, o, 300 + n);
+			expectFound(
+				label("noise", sigma, n), (n * 29 + 7) % 256, 1.0 + k, 20.0 * k * kDeg, o, 300 + n);
 		}
 }
 
@@ -111,7 +117,9 @@ TEST(Renders, BlurUpTo1p5)
 		{
 			auto o = nominalRender();
 			o.blur_sigma_px = blur;
-			expectFound(label("blur", blur, n), (n * 41 + 3) % 256, 1.0 + 0.5 * k, 25.0 * k * kDeg, o, 400 + n);
+			expectFound(
+				label("blur", blur, n), (n * 41 + 3) % 256, 1.0 + 0.5 * k, 25.0 * k * kDeg, o,
+				400 + n);
 		}
 }
 
@@ -123,15 +131,18 @@ TEST(Renders, JpegDownTo70)
 		{
 			auto o = nominalRender();
 			o.jpeg_quality = q;
-			expectFound(label("jpeg", q, n), (n * 13 + 11) % 256, 1.0 + 0.75 * k, 20.0 * k * kDeg, o, 500 + n);
+			expectFound(
+				label("jpeg", q, n), (n * 13 + 11) % 256, 1.0 + 0.75 * k, 20.0 * k * kDeg, o,
+				500 + n);
 		}
 }
 
 TEST(Renders, Combination5mAt60Deg)
 {
 	for (int k = 0; k < 6; ++k)
-		expectFound(label("5m60deg", k, k), (k * 97 + 2) % 256, 5.0, (k % 2 ? 60 : -60) * kDeg, nominalRender(), 600 + k,
-			0.05 * (k - 3), 0, kFarObliqueTolPx);
+		expectFound(
+			label("5m60deg", k, k), (k * 97 + 2) % 256, 5.0, (k % 2 ? 60 : -60) * kDeg,
+			nominalRender(), 600 + k, 0.05 * (k - 3), 0, kFarObliqueTolPx);
 }
 
 TEST(Renders, Combination2mBlur1p5Gain0p3)
@@ -142,7 +153,9 @@ TEST(Renders, Combination2mBlur1p5Gain0p3)
 		o.blur_sigma_px = 1.5;
 		o.gain = 0.3;
 		o.gradient = 0.3;
-		expectFound(label("2m blur1.5 gain0.3", k, k), (k * 89 + 4) % 256, 2.0, (k * 10) * kDeg, o, 700 + k);
+		expectFound(
+			label("2m blur1.5 gain0.3", k, k), (k * 89 + 4) % 256, 2.0, (k * 10) * kDeg, o,
+			700 + k);
 	}
 }
 
@@ -181,7 +194,8 @@ TEST(Renders, DistortedCamera)
 			const std::string what = label("distorted d", d, n);
 			++n;
 			ASSERT_TRUE(t.fully_visible) << what;
-			const auto r = detect::detect(s.render.image, cam, LandmarkGeometry(), DetectorOptions());
+			const auto r =
+				detect::detect(s.render.image, cam, LandmarkGeometry(), DetectorOptions());
 			ASSERT_EQ(r.landmarks.size(), 1u) << what;
 			EXPECT_EQ(r.landmarks[0].detection.id, lm.id) << what;
 			EXPECT_LT(maxCornerError(r.landmarks[0].detection, t), kCornerTolPx) << what;
@@ -217,10 +231,12 @@ TEST(Renders, SeveralLandmarksAreAllFound)
 		{
 			if (!t.fully_visible) continue;
 			++visible;
-			const auto it = std::find_if(res.landmarks.begin(), res.landmarks.end(),
+			const auto it = std::find_if(
+				res.landmarks.begin(), res.landmarks.end(),
 				[&](const DetectedLandmark& d) { return d.detection.id == t.id; });
 			ASSERT_NE(it, res.landmarks.end()) << "scene " << k << " id " << t.id;
-			EXPECT_LT(maxCornerError(it->detection, t), kCornerTolPx) << "scene " << k << " id " << t.id;
+			EXPECT_LT(maxCornerError(it->detection, t), kCornerTolPx)
+				<< "scene " << k << " id " << t.id;
 		}
 		EXPECT_GE(visible, 3);
 		EXPECT_EQ(static_cast<int>(res.landmarks.size()), visible) << "scene " << k;
@@ -299,12 +315,16 @@ TEST(Renders, FrameFilledWithAnotherColourIsNotALandmark)
 {
 	const LandmarkGeometry g;
 	const double h = g.innerHalf();
-	for (const cv::Scalar& fill : {cv::Scalar(30, 30, 200), cv::Scalar(200, 40, 30), cv::Scalar(0, 200, 200),
-			 cv::Scalar(235, 235, 235), cv::Scalar(40, 120, 160)})
+	for (const cv::Scalar& fill :
+		 {cv::Scalar(30, 30, 200), cv::Scalar(200, 40, 30), cv::Scalar(0, 200, 200),
+		  cv::Scalar(235, 235, 235), cv::Scalar(40, 120, 160)})
 	{
 		Shot s = shoot(77, 1.5, 10 * kDeg, nominalRender(), 1500);
-		paintFace(s.render.image, s.render.truth[0], g,
-			{Eigen::Vector2d(-h, h), Eigen::Vector2d(h, h), Eigen::Vector2d(h, -h), Eigen::Vector2d(-h, -h)}, fill);
+		paintFace(
+			s.render.image, s.render.truth[0], g,
+			{Eigen::Vector2d(-h, h), Eigen::Vector2d(h, h), Eigen::Vector2d(h, -h),
+			 Eigen::Vector2d(-h, -h)},
+			fill);
 		paintCell(s.render.image, s.render.truth[0], 1, 1, true);
 		EXPECT_TRUE(run(s.render.image).landmarks.empty()) << fill;
 	}

@@ -29,7 +29,9 @@ cv::Mat craftedLandmark(int id, int o = 40, double blur = 0.8, int size = 180)
 	// Board: 45 px centred in the 80 px fill: cells start at o + 10 + 17.5.
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)
-			if (cells[r][c]) cv::rectangle(img, cv::Rect(o + 28 + 15 * c, o + 28 + 15 * r, 15, 15), kBlack, cv::FILLED);
+			if (cells[r][c])
+				cv::rectangle(
+					img, cv::Rect(o + 28 + 15 * c, o + 28 + 15 * r, 15, 15), kBlack, cv::FILLED);
 	if (blur > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), blur);
 	return img;
 }
@@ -37,7 +39,8 @@ cv::Mat craftedLandmark(int id, int o = 40, double blur = 0.8, int size = 180)
 std::array<Eigen::Vector2d, 4> craftedCorners(int o = 40)
 {
 	const double a = o + 9.5, b = o + 89.5;
-	return {Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b), Eigen::Vector2d(a, b)};
+	return {
+		Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b), Eigen::Vector2d(a, b)};
 }
 }  // namespace
 
@@ -47,15 +50,15 @@ TEST(Segmentation, PredicateAcceptsGreensAndRejectsOthers)
 {
 	const SegmentationParams p;
 	EXPECT_TRUE(isFillColour(0, 255, 0, p));
-	EXPECT_TRUE(isFillColour(0, 77, 0, p));  // gain 0.3
+	EXPECT_TRUE(isFillColour(0, 77, 0, p));	 // gain 0.3
 	EXPECT_TRUE(isFillColour(20, 200, 40, p));
 	EXPECT_FALSE(isFillColour(128, 128, 128, p));  // grey
 	EXPECT_FALSE(isFillColour(235, 235, 235, p));  // white
-	EXPECT_FALSE(isFillColour(5, 9, 5, p));  // black: too dark
-	EXPECT_FALSE(isFillColour(200, 40, 30, p));  // red
-	EXPECT_FALSE(isFillColour(30, 40, 200, p));  // blue
-	EXPECT_FALSE(isFillColour(0, 220, 230, p));  // yellow-green? no: cyan-ish (B > G)
-	EXPECT_FALSE(isFillColour(230, 240, 0, p));  // yellow: hue ~62 deg
+	EXPECT_FALSE(isFillColour(5, 9, 5, p));	 // black: too dark
+	EXPECT_FALSE(isFillColour(200, 40, 30, p));	 // red
+	EXPECT_FALSE(isFillColour(30, 40, 200, p));	 // blue
+	EXPECT_FALSE(isFillColour(0, 220, 230, p));	 // yellow-green? no: cyan-ish (B > G)
+	EXPECT_FALSE(isFillColour(230, 240, 0, p));	 // yellow: hue ~62 deg
 	EXPECT_FALSE(isFillColour(150, 190, 150, p));  // pale green: low saturation
 }
 
@@ -91,7 +94,8 @@ TEST(Segmentation, GridMaskIsThePredicateOnEveryCell)
 				for (int x = 0; x < img.cols; x += 2)
 				{
 					auto& px = img.at<cv::Vec3b>(y, x);
-					px[1] = cv::saturate_cast<uint8_t>(std::max(px[0], px[2]) + rng.uniform(-5, 60));
+					px[1] =
+						cv::saturate_cast<uint8_t>(std::max(px[0], px[2]) + rng.uniform(-5, 60));
 				}
 			SegmentationParams p;
 			p.step_px = step;
@@ -102,7 +106,8 @@ TEST(Segmentation, GridMaskIsThePredicateOnEveryCell)
 				{
 					const auto& px = img.at<cv::Vec3b>(i * step, j * step);
 					const bool want = isFillColour(px[2], px[1], px[0], p);
-					ASSERT_EQ(m.at<uint8_t>(i, j) != 0, want) << size << " step " << step << " cell " << i << "," << j;
+					ASSERT_EQ(m.at<uint8_t>(i, j) != 0, want)
+						<< size << " step " << step << " cell " << i << "," << j;
 					fill += want;
 				}
 			EXPECT_GT(fill, 0);
@@ -122,7 +127,7 @@ TEST(Segmentation, TinyAndEmptyImagesGiveAnEmptyMask)
 TEST(Components, HandMadeMask)
 {
 	cv::Mat mask = cv::Mat::zeros(60, 80, CV_8UC1);
-	cv::rectangle(mask, cv::Rect(10, 10, 20, 20), 255, cv::FILLED);  // a square
+	cv::rectangle(mask, cv::Rect(10, 10, 20, 20), 255, cv::FILLED);	 // a square
 	cv::rectangle(mask, cv::Rect(40, 5, 1, 50), 255, cv::FILLED);  // a thin line
 	cv::rectangle(mask, cv::Rect(75, 55, 2, 2), 255, cv::FILLED);  // a speck
 	// Touching diagonally only: a separate component under N4.
@@ -130,7 +135,7 @@ TEST(Components, HandMadeMask)
 	cv::rectangle(mask, cv::Rect(60, 40, 10, 10), 255, cv::FILLED);
 	const cv::Mat img(120, 160, CV_8UC3, kGreen);
 	ComponentParams p;
-	p.max_frame_ratio = 1;  // no frame in this image: frame evidence off
+	p.max_frame_ratio = 1;	// no frame in this image: frame evidence off
 	cv::Mat labels;
 	int n = 0;
 	const auto c = findCandidates(mask, 2, img, p, &labels, &n);
@@ -155,7 +160,7 @@ TEST(Components, ARingIsCompactEnoughAndALShapeIsNot)
 	cv::Mat mask = cv::Mat::zeros(100, 100, CV_8UC1);
 	cv::rectangle(mask, cv::Rect(10, 10, 32, 32), 255, cv::FILLED);
 	cv::rectangle(mask, cv::Rect(17, 17, 18, 18), 0, cv::FILLED);  // an all-black board (90/160)
-	cv::rectangle(mask, cv::Rect(50, 50, 45, 3), 255, cv::FILLED);  // a thin L
+	cv::rectangle(mask, cv::Rect(50, 50, 45, 3), 255, cv::FILLED);	// a thin L
 	cv::rectangle(mask, cv::Rect(50, 50, 3, 45), 255, cv::FILLED);
 	const cv::Mat img(200, 200, CV_8UC3, kGreen);
 	ComponentParams p;
@@ -170,12 +175,16 @@ TEST(Components, FrameEvidence)
 	// The crafted landmark has its frame; the same fill on grey or on white
 	// has none.
 	const cv::Mat lm = craftedLandmark(0);
-	EXPECT_EQ(findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(), 1u);
+	EXPECT_EQ(
+		findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(),
+		1u);
 	for (const cv::Scalar& bg : {cv::Scalar(128, 128, 128), kWhite})
 	{
 		cv::Mat img(180, 180, CV_8UC3, bg);
 		cv::rectangle(img, cv::Rect(50, 50, 80, 80), kGreen, cv::FILLED);
-		EXPECT_TRUE(findCandidates(segmentColour(img, SegmentationParams()), 2, img, ComponentParams()).empty());
+		EXPECT_TRUE(
+			findCandidates(segmentColour(img, SegmentationParams()), 2, img, ComponentParams())
+				.empty());
 	}
 }
 
@@ -185,7 +194,9 @@ TEST(Components, CentreEvidence)
 	// rejected before the gradients once the cell (15 px here) is large
 	// enough to open a hole in the mask; kept with the test off.
 	const cv::Mat lm = craftedLandmark(0);
-	EXPECT_EQ(findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(), 1u);
+	EXPECT_EQ(
+		findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(),
+		1u);
 	cv::Mat solid = craftedLandmark(0, 40, 0);
 	cv::rectangle(solid, cv::Rect(40 + 28 + 15, 40 + 28 + 15, 15, 15), kGreen, cv::FILLED);
 	cv::GaussianBlur(solid, solid, cv::Size(0, 0), 0.8);
@@ -207,21 +218,26 @@ TEST(Edgels, PolarityOfTheInnerEdges)
 {
 	const cv::Mat img = craftedLandmark(0);
 	EdgelParams full;
-	full.max_roi_px = 1000;  // no reduction
+	full.max_roi_px = 1000;	 // no reduction
 	const auto m = findEdgels(img, cv::Rect(20, 20, 140, 140), 10, full);
 	ASSERT_EQ(m.scale, 1);
 	// Inner left edge between pixels 49 and 50: G rises to the right.
-	EXPECT_EQ(m.polarity.at<uint8_t>(90 - 20, 49 - 20) | m.polarity.at<uint8_t>(90 - 20, 50 - 20),
+	EXPECT_EQ(
+		m.polarity.at<uint8_t>(90 - 20, 49 - 20) | m.polarity.at<uint8_t>(90 - 20, 50 - 20),
 		static_cast<uint8_t>(Polarity::Left));
-	EXPECT_EQ(m.polarity.at<uint8_t>(90 - 20, 129 - 20) | m.polarity.at<uint8_t>(90 - 20, 130 - 20),
+	EXPECT_EQ(
+		m.polarity.at<uint8_t>(90 - 20, 129 - 20) | m.polarity.at<uint8_t>(90 - 20, 130 - 20),
 		static_cast<uint8_t>(Polarity::Right));
-	EXPECT_EQ(m.polarity.at<uint8_t>(49 - 20, 90 - 20) | m.polarity.at<uint8_t>(50 - 20, 90 - 20),
+	EXPECT_EQ(
+		m.polarity.at<uint8_t>(49 - 20, 90 - 20) | m.polarity.at<uint8_t>(50 - 20, 90 - 20),
 		static_cast<uint8_t>(Polarity::Top));
-	EXPECT_EQ(m.polarity.at<uint8_t>(129 - 20, 90 - 20) | m.polarity.at<uint8_t>(130 - 20, 90 - 20),
+	EXPECT_EQ(
+		m.polarity.at<uint8_t>(129 - 20, 90 - 20) | m.polarity.at<uint8_t>(130 - 20, 90 - 20),
 		static_cast<uint8_t>(Polarity::Bottom));
 	// Non-maximum suppression: one edgel across the edge.
 	int across = 0;
-	for (int x = 44; x <= 56; ++x) across += m.polarity.at<uint8_t>(70, x - 20) == static_cast<uint8_t>(Polarity::Left);
+	for (int x = 44; x <= 56; ++x)
+		across += m.polarity.at<uint8_t>(70, x - 20) == static_cast<uint8_t>(Polarity::Left);
 	EXPECT_EQ(across, 1);
 	// A long slim domain of each polarity.
 	for (const Polarity pol : {Polarity::Top, Polarity::Right, Polarity::Bottom, Polarity::Left})
@@ -237,7 +253,8 @@ TEST(Edgels, PolarityOfTheInnerEdges)
 	ASSERT_EQ(r.scale, 2);
 	bool left_found = false;
 	for (const auto& d : r.domains)
-		if (d.polarity == Polarity::Left && d.length_px > 60 && d.mean.x() < 90)  // not the outer right edge
+		if (d.polarity == Polarity::Left && d.length_px > 60 &&
+			d.mean.x() < 90)  // not the outer right edge
 		{
 			EXPECT_NEAR(d.mean.x(), 49.5, 1.0);
 			EXPECT_NEAR(d.mean.y(), 89.5, 3.0);
@@ -262,7 +279,8 @@ std::optional<Quad> coarseQuad(const cv::Mat& img)
 	const cv::Mat mask = segmentColour(img, SegmentationParams());
 	const auto cands = findCandidates(mask, 2, img, ComponentParams());
 	if (cands.size() != 1) return std::nullopt;
-	const auto m = findEdgels(img, cands[0].roi, gradientThreshold(cands[0].fill_g, EdgelParams()), EdgelParams());
+	const auto m = findEdgels(
+		img, cands[0].roi, gradientThreshold(cands[0].fill_g, EdgelParams()), EdgelParams());
 	const auto s = selectSegments(m.domains, cands[0], mask, 2, SegmentParams());
 	if (!s) return std::nullopt;
 	return linkQuadrangle(*s, QuadParams());
@@ -276,7 +294,8 @@ TEST(Quadrangle, CoarseCornersOfACraftedLandmark)
 		const auto q = coarseQuad(craftedLandmark(id));
 		ASSERT_TRUE(q) << id;
 		const auto truth = craftedCorners();
-		for (int k = 0; k < 4; ++k) EXPECT_LT(((*q)[k] - truth[k]).norm(), 1.5) << id << " corner " << k;
+		for (int k = 0; k < 4; ++k)
+			EXPECT_LT(((*q)[k] - truth[k]).norm(), 1.5) << id << " corner " << k;
 	}
 }
 
@@ -324,7 +343,8 @@ std::vector<int> stepProfile(double x0, double sigma, int n, double hi = 230)
 		for (int k = 0; k < kSub; ++k)
 		{
 			const double x = i - 0.5 + (k + 0.5) / kSub;
-			s += sigma > 0 ? 0.5 * (1 + std::erf((x - x0) / (std::sqrt(2.0) * sigma))) : (x > x0 ? 1.0 : 0.0);
+			s += sigma > 0 ? 0.5 * (1 + std::erf((x - x0) / (std::sqrt(2.0) * sigma)))
+						   : (x > x0 ? 1.0 : 0.0);
 		}
 		v[i] = static_cast<int>(std::lround(std::min(255.0, 30 + (hi - 30) * s / kSub)));
 	}
@@ -384,7 +404,8 @@ TEST(Subpixel, LineFitRejectsOutliers)
 	EXPECT_EQ(f->support, 58);
 	EXPECT_LT(f->rms_px, 0.08);
 	// Distance of a point of the true line to the fit.
-	for (double u : {0.0, 59.0}) EXPECT_LT(std::abs(f->normal.dot(Eigen::Vector2d(u, 0.1 * u + 20)) + f->c), 0.05);
+	for (double u : {0.0, 59.0})
+		EXPECT_LT(std::abs(f->normal.dot(Eigen::Vector2d(u, 0.1 * u + 20)) + f->c), 0.05);
 	EXPECT_FALSE(fitLine({pts.begin(), pts.begin() + 3}, SubpixelParams()));
 }
 
@@ -400,7 +421,8 @@ TEST(Subpixel, RefinedCornersOfACraftedLandmark)
 		const auto truth = craftedCorners();
 		for (int k = 0; k < 4; ++k)
 		{
-			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.02) << "blur " << blur << " corner " << k;
+			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.02)
+				<< "blur " << blur << " corner " << k;
 			EXPECT_LT(r->sides[k].rms_px, 0.05);
 			EXPECT_GT(r->sides[k].support, 60);
 		}
@@ -411,7 +433,9 @@ TEST(Subpixel, RefinedCornersOfACraftedLandmark)
 
 TEST(Code, HomographyMapsTheUnitSquareToTheCorners)
 {
-	const Quad c = {Eigen::Vector2d(10, 12), Eigen::Vector2d(50, 8), Eigen::Vector2d(55, 60), Eigen::Vector2d(8, 50)};
+	const Quad c = {
+		Eigen::Vector2d(10, 12), Eigen::Vector2d(50, 8), Eigen::Vector2d(55, 60),
+		Eigen::Vector2d(8, 50)};
 	const Eigen::Matrix3d H = faceToImage(c);
 	const double src[4][2] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
 	for (int k = 0; k < 4; ++k)
@@ -454,7 +478,8 @@ TEST(Code, RejectsGreenCentreOtherFillAndMissingFrame)
 	RefinedQuad q;
 	q.corners_raw = q.corners_ideal = craftedCorners();
 	cv::Mat img = craftedLandmark(0);
-	cv::rectangle(img, cv::Rect(40 + 43, 40 + 43, 15, 15), kGreen, cv::FILLED);  // centre cell green
+	cv::rectangle(
+		img, cv::Rect(40 + 43, 40 + 43, 15, 15), kGreen, cv::FILLED);  // centre cell green
 	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
 	// No frame: the frame painted white.
 	img = craftedLandmark(0, 40, 0);
@@ -510,7 +535,8 @@ TEST(Detect, DegenerateInputsGiveNothing)
 	EXPECT_TRUE(detect::detect(cv::Mat(0, 0, CV_8UC3), cam, g, o).landmarks.empty());
 	EXPECT_TRUE(detect::detect(cv::Mat(1, 1, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
 	EXPECT_TRUE(detect::detect(cv::Mat(3, 2, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
-	EXPECT_TRUE(detect::detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(128, 128, 128)), cam, g, o).landmarks.empty());
+	EXPECT_TRUE(detect::detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(128, 128, 128)), cam, g, o)
+					.landmarks.empty());
 	EXPECT_TRUE(detect::detect(cv::Mat(480, 640, CV_8UC3, kGreen), cam, g, o).landmarks.empty());
 	EXPECT_THROW(detect::detect(cv::Mat(10, 10, CV_8UC1), cam, g, o), std::invalid_argument);
 }
@@ -521,12 +547,15 @@ TEST(Detect, GreenPostersWithoutAFrameAreNotLandmarks)
 	{
 		cv::Mat img(200, 200, CV_8UC3, bg);
 		cv::rectangle(img, cv::Rect(50, 50, 100, 100), kGreen, cv::FILLED);
-		cv::rectangle(img, cv::Rect(90, 90, 20, 20), kBlack, cv::FILLED);  // even with a black centre
+		cv::rectangle(
+			img, cv::Rect(90, 90, 20, 20), kBlack, cv::FILLED);	 // even with a black centre
 		cv::GaussianBlur(img, img, cv::Size(0, 0), 0.8);
-		EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions()).landmarks.empty());
+		EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions())
+						.landmarks.empty());
 	}
 	// A green square on black: a frame, but the centre cell is green.
 	cv::Mat img(200, 200, CV_8UC3, kBlack);
 	cv::rectangle(img, cv::Rect(50, 50, 100, 100), kGreen, cv::FILLED);
-	EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions()).landmarks.empty());
+	EXPECT_TRUE(detect::detect(img, CameraModel(), LandmarkGeometry(), DetectorOptions())
+					.landmarks.empty());
 }

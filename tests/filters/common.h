@@ -17,14 +17,15 @@ namespace codemark::filters::test
 inline mrpt::poses::CPose3D cameraOnRobot(double yaw = 0.0)
 {
 	return mrpt::poses::CPose3D(0.1, 0.0, 0.6, yaw, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
 /** Landmarks on the walls of a 6 x 4 m room, facing in. */
 inline LandmarkMap roomMap()
 {
 	LandmarkMap m;
-	auto add = [&](int id, double x, double y, double yaw_deg) {
+	auto add = [&](int id, double x, double y, double yaw_deg)
+	{
 		MapLandmark l;
 		l.id = id, l.x_m = x, l.y_m = y, l.z_m = 0.6, l.yaw_rad = yaw_deg * M_PI / 180.0;
 		m.landmarks.push_back(l);

@@ -24,7 +24,8 @@ PoseEstimate guess(const CPose2D& p, double sxy, double syaw)
 
 bool isSpd(const Eigen::Matrix3d& P)
 {
-	if (!P.allFinite() || (P - P.transpose()).cwiseAbs().maxCoeff() > 1e-12 * std::max(1.0, P.norm()))
+	if (!P.allFinite() ||
+		(P - P.transpose()).cwiseAbs().maxCoeff() > 1e-12 * std::max(1.0, P.norm()))
 		return false;
 	return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P).eigenvalues()[0] > 0;
 }
@@ -52,11 +53,14 @@ TEST(EkfModel, ObservationJacobianMatchesNumeric)
 		{
 			Eigen::Vector3d xp = x, xm = x;
 			xp[j] += eps, xm[j] -= eps;
-			Eigen::Vector3d d = predictLandmarkMeasurement(xp, cam, lm) - predictLandmarkMeasurement(xm, cam, lm);
+			Eigen::Vector3d d =
+				predictLandmarkMeasurement(xp, cam, lm) - predictLandmarkMeasurement(xm, cam, lm);
 			d[1] = mrpt::math::wrapToPi(d[1]), d[2] = mrpt::math::wrapToPi(d[2]);
 			Hn.col(j) = d / (2 * eps);
 		}
-		EXPECT_LT((H - Hn).cwiseAbs().maxCoeff(), 1e-6) << "x " << x.transpose() << "\nH\n" << H << "\nHn\n" << Hn;
+		EXPECT_LT((H - Hn).cwiseAbs().maxCoeff(), 1e-6) << "x " << x.transpose() << "\nH\n"
+														<< H << "\nHn\n"
+														<< Hn;
 		EXPECT_GT(h0[0], 0);
 	}
 }
@@ -114,12 +118,15 @@ TEST_P(BothVariants, PerfectMeasurementsConvergeToTheTruePose)
 {
 	const LandmarkMap map = roomMap();
 	const CPose2D truth(4.5, 2.0, 0.1);
-	auto f = makeEkfLocalizer(GetParam(), EkfOptions(), map, guess(CPose2D(4.3, 2.2, 0.05), 0.3, 0.2));
+	auto f =
+		makeEkfLocalizer(GetParam(), EkfOptions(), map, guess(CPose2D(4.3, 2.2, 0.05), 0.3, 0.2));
 	const auto cam = cameraOnRobot();
 	for (int k = 0; k < 20; ++k)
 	{
-		const auto st = f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[0], kSigma),
-											 sighting(truth, cam, map.landmarks[1], kSigma)}));
+		const auto st = f->step(
+			nullptr, frameOf(
+						 {sighting(truth, cam, map.landmarks[0], kSigma),
+						  sighting(truth, cam, map.landmarks[1], kSigma)}));
 		EXPECT_EQ(st.used, 2);
 		EXPECT_EQ(st.rejected, 0);
 	}
@@ -154,8 +161,9 @@ TEST_P(BothVariants, GlobalInitialisationFromOneLandmark)
 	// The covariance is the fix's: C_R propagated into the world.
 	const auto s = sighting(truth, cam, map.landmarks[2], kSigma);
 	Eigen::Matrix3d C;
-	pose::robotPoseInWorld(s.pose_in_landmark, s.C_R,
-		pose::landmarkPlanarPose(map.landmarks[2].world_T_landmark()), pose::cameraPlanarPose(cam), &C);
+	pose::robotPoseInWorld(
+		s.pose_in_landmark, s.C_R, pose::landmarkPlanarPose(map.landmarks[2].world_T_landmark()),
+		pose::cameraPlanarPose(cam), &C);
 	EXPECT_LT((e.cov - C).cwiseAbs().maxCoeff(), 1e-12);
 }
 
@@ -165,7 +173,8 @@ TEST_P(BothVariants, AngleWrapAcrossPi)
 	const LandmarkMap map = roomMap();
 	const CPose2D truth(3.0, 1.0, M_PI - 0.01);
 	// Prior on the other side of the cut: -pi + 0.01 (0.02 rad away).
-	auto f = makeEkfLocalizer(GetParam(), EkfOptions(), map, guess(CPose2D(3.0, 1.0, -M_PI + 0.01), 0.05, 0.05));
+	auto f = makeEkfLocalizer(
+		GetParam(), EkfOptions(), map, guess(CPose2D(3.0, 1.0, -M_PI + 0.01), 0.05, 0.05));
 	const auto cam = cameraOnRobot();
 	for (int k = 0; k < 5; ++k)
 	{
@@ -185,8 +194,10 @@ TEST_P(BothVariants, GateRejectsAPlantedWrongIdSighting)
 	auto f = makeEkfLocalizer(GetParam(), EkfOptions(), map, guess(truth, 0.02, 0.01));
 	const auto cam = cameraOnRobot();
 	// Landmark 1 seen, but reported with landmark 2's ID (2 m away).
-	const auto st = f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[0], kSigma),
-										 sighting(truth, cam, map.landmarks[0], kSigma, nullptr, 2)}));
+	const auto st = f->step(
+		nullptr, frameOf(
+					 {sighting(truth, cam, map.landmarks[0], kSigma),
+					  sighting(truth, cam, map.landmarks[0], kSigma, nullptr, 2)}));
 	EXPECT_EQ(st.used, 1);
 	EXPECT_EQ(st.rejected, 1);
 	EXPECT_FALSE(st.reinitialized);
@@ -212,7 +223,8 @@ TEST_P(BothVariants, KidnappedRobotRecovers)
 	bool reinit = false;
 	for (int k = 0; k < 10 && !reinit; ++k)
 	{
-		const auto st = f->step(&still, frameOf({sighting(b, cam, map.landmarks[2], kSigma, &rng)}));
+		const auto st =
+			f->step(&still, frameOf({sighting(b, cam, map.landmarks[2], kSigma, &rng)}));
 		rejected += st.rejected;
 		reinit = st.reinitialized;
 	}
@@ -220,8 +232,10 @@ TEST_P(BothVariants, KidnappedRobotRecovers)
 	EXPECT_EQ(rejected, o.kidnap_rejections);
 	for (int k = 0; k < 10; ++k)
 	{
-		const auto st = f->step(&still, frameOf({sighting(b, cam, map.landmarks[2], kSigma, &rng),
-											 sighting(b, cam, map.landmarks[3], kSigma, &rng)}));
+		const auto st = f->step(
+			&still, frameOf(
+						{sighting(b, cam, map.landmarks[2], kSigma, &rng),
+						 sighting(b, cam, map.landmarks[3], kSigma, &rng)}));
 		EXPECT_EQ(st.rejected, 0);
 	}
 	EXPECT_NEAR(f->estimate().mean.x(), b.x(), 0.01);
@@ -242,13 +256,15 @@ TEST_P(BothVariants, CovarianceStaysSymmetricPositiveDefiniteOver10kRandomSteps)
 	{
 		// Random motion with a random (sometimes tiny, sometimes huge) noise,
 		// sightings from a random nearby pose with a random noise level.
-		const auto odo = odometry(CPose2D(0.1 * u(rng), 0.05 * u(rng), 0.3 * u(rng)),
+		const auto odo = odometry(
+			CPose2D(0.1 * u(rng), 0.05 * u(rng), 0.3 * u(rng)),
 			std::pow(10.0, -4 + 3 * (u(rng) + 1) / 2), std::pow(10.0, -4 + 3 * (u(rng) + 1) / 2));
 		const CPose2D where(3 + 2 * u(rng), 2 + 1.5 * u(rng), M_PI * u(rng));
 		const Eigen::Vector3d sigma = kSigma * std::pow(10.0, 2 * u(rng));
 		std::vector<CObservationCodedLandmarks::TSighting> s;
 		const int n = static_cast<int>((u(rng) + 1) * 1.5);
-		for (int i = 0; i < n; ++i) s.push_back(sighting(where, cam, map.landmarks[pick(rng)], sigma, &rng));
+		for (int i = 0; i < n; ++i)
+			s.push_back(sighting(where, cam, map.landmarks[pick(rng)], sigma, &rng));
 		StepStats st;
 		ASSERT_NO_THROW(st = f->step(&odo, frameOf(s))) << "step " << k;
 		used += st.used;
@@ -259,8 +275,8 @@ TEST_P(BothVariants, CovarianceStaysSymmetricPositiveDefiniteOver10kRandomSteps)
 	EXPECT_GT(used, 100);  // the updates did run
 }
 
-INSTANTIATE_TEST_SUITE_P(Ekf, BothVariants,
-	::testing::Values(EkfMeasurement::Landmark, EkfMeasurement::PoseFix),
+INSTANTIATE_TEST_SUITE_P(
+	Ekf, BothVariants, ::testing::Values(EkfMeasurement::Landmark, EkfMeasurement::PoseFix),
 	[](const auto& info) { return info.param == EkfMeasurement::Landmark ? "ekf" : "ekf_pose"; });
 
 TEST(EkfFactory, MakeLocalizerSelectsTheVariant)
@@ -293,14 +309,17 @@ TEST(Ekf, IteratedUpdateIsConsistentFromAWidePrior)
 		const int runs = 300;
 		for (int run = 0; run < runs; ++run)
 		{
-			const CPose2D truth(3.0, 1.0, 0.0);  // landmark 1 (6, 1) straight ahead, 2.9 m
+			const CPose2D truth(3.0, 1.0, 0.0);	 // landmark 1 (6, 1) straight ahead, 2.9 m
 			// The prior's mean is drawn from the prior around the truth.
-			const CPose2D prior(truth.x() + 0.1 * n(rng), truth.y() + 0.1 * n(rng), truth.phi() + 0.05 * n(rng));
+			const CPose2D prior(
+				truth.x() + 0.1 * n(rng), truth.y() + 0.1 * n(rng), truth.phi() + 0.05 * n(rng));
 			auto f = makeEkfLocalizer(EkfMeasurement::Landmark, o, map, guess(prior, 0.1, 0.05));
-			const auto st = f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[0], sigma, &rng)}));
+			const auto st =
+				f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[0], sigma, &rng)}));
 			ASSERT_EQ(st.used, 1);
 			const auto e = f->estimate();
-			const Eigen::Vector3d err(e.mean.x() - truth.x(), e.mean.y() - truth.y(),
+			const Eigen::Vector3d err(
+				e.mean.x() - truth.x(), e.mean.y() - truth.y(),
 				mrpt::math::wrapToPi(e.mean.phi() - truth.phi()));
 			sum += err.dot(e.cov.ldlt().solve(err));
 		}
@@ -313,7 +332,8 @@ TEST(Ekf, IteratedUpdateIsConsistentFromAWidePrior)
 	// The plain EKF measured about 100.
 	EXPECT_GT(mean_nees[1], 2.6);
 	EXPECT_LT(mean_nees[1], 4.0);
-	EXPECT_GT(mean_nees[0], 5 * mean_nees[1]) << "the plain EKF should be clearly overconfident here";
+	EXPECT_GT(mean_nees[0], 5 * mean_nees[1])
+		<< "the plain EKF should be clearly overconfident here";
 }
 
 // A map with no landmarks cannot localise anything: a clear error at

@@ -23,7 +23,8 @@ namespace
 {
 fs::path tempDir()
 {
-	const auto dir = fs::temp_directory_path() / ("codemark_test_outputs_" + std::to_string(getpid()));
+	const auto dir =
+		fs::temp_directory_path() / ("codemark_test_outputs_" + std::to_string(getpid()));
 	fs::create_directories(dir);
 	return dir;
 }
@@ -48,8 +49,8 @@ TEST(GroundTruth, TimestampedRowsMatchByTimestamp)
 
 TEST(GroundTruth, MrptPathStepIMatchesRowIPlusOne)
 {
-	const auto gt = GroundTruth::load(
-		writeText("path.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
+	const auto gt = GroundTruth::load(writeText(
+		"path.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
 	EXPECT_EQ(gt.form(), GroundTruth::Form::MrptPath);
 	ASSERT_TRUE(gt.poseAt(0, 12345.0));
 	EXPECT_DOUBLE_EQ(gt.poseAt(0, 0)->x(), 1.0);
@@ -59,8 +60,8 @@ TEST(GroundTruth, MrptPathStepIMatchesRowIPlusOne)
 
 TEST(GroundTruth, MrptPathRowIsTheActionCountWhenGiven)
 {
-	const auto gt = GroundTruth::load(
-		writeText("path_actions.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
+	const auto gt = GroundTruth::load(writeText(
+		"path_actions.txt", "% x y z yaw pitch roll\n0 0 0 0 0 0\n1 0 0 0.1 0 0\n2 0 0 0.2 0 0\n"));
 	// A frame ahead of the first action: row 0, whatever its step index.
 	ASSERT_TRUE(gt.poseAt(0, 0, 1e-3, 0));
 	EXPECT_DOUBLE_EQ(gt.poseAt(0, 0, 1e-3, 0)->x(), 0.0);
@@ -85,7 +86,8 @@ TEST(GroundTruth, BadRowsNameFileAndLine)
 		EXPECT_NE(std::string(e.what()).find("bad.txt:2"), std::string::npos) << e.what();
 	}
 	EXPECT_THROW(GroundTruth::load(writeText("cols.txt", "1 2 3\n")), std::runtime_error);
-	EXPECT_THROW(GroundTruth::load(writeText("mixed.txt", "1 2 3 4\n1 2 3 4 5 6\n")), std::runtime_error);
+	EXPECT_THROW(
+		GroundTruth::load(writeText("mixed.txt", "1 2 3 4\n1 2 3 4 5 6\n")), std::runtime_error);
 }
 
 TEST(Metrics, KnownErrors)
@@ -146,12 +148,14 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 			const double t = 1700000000.0 + 0.2 * k;
 			for (auto& o : sf) o->timestamp = mrpt::Clock::fromDouble(t);
 			ar << sf;
-			gt << std::setprecision(6) << t << ' ' << truth.x() << ' ' << truth.y() << ' ' << truth.phi() << '\n';
+			gt << std::setprecision(6) << t << ' ' << truth.x() << ' ' << truth.y() << ' '
+			   << truth.phi() << '\n';
 		}
 	}
 	gt.close();
 	LocalizeRequest req;
-	req.config_file = writeText("ekf.ini", "[localize]\nmethod = ekf\n[ekf]\ngate_probability = 0.999\n");
+	req.config_file =
+		writeText("ekf.ini", "[localize]\nmethod = ekf\n[ekf]\ngate_probability = 0.999\n");
 	req.rawlog = rawlog;
 	req.map_file = (dir / "map.txt").string();
 	req.gt_file = (dir / "gt.txt").string();
@@ -162,8 +166,9 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 	EXPECT_GT(s.sightings_used, 100);
 	ASSERT_TRUE(s.metrics);
 	EXPECT_LT(s.metrics->ate_rmse_m, 0.02);
-	for (const char* f : {"estimated_path.txt", "estimated_path.tum", "covariances.txt", "trajectory.png",
-			 "trajectory.3Dscene", "summary.json"})
+	for (const char* f :
+		 {"estimated_path.txt", "estimated_path.tum", "covariances.txt", "trajectory.png",
+		  "trajectory.3Dscene", "summary.json"})
 		EXPECT_TRUE(fs::exists(fs::path(req.out_dir) / f)) << f;
 	std::ifstream path(fs::path(req.out_dir) / "estimated_path.txt");
 	std::string line;
@@ -174,8 +179,10 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 	EXPECT_NE(line.find(".000000 "), std::string::npos) << line;  // >= 6 decimals
 	std::ifstream js(fs::path(req.out_dir) / "summary.json");
 	const std::string json((std::istreambuf_iterator<char>(js)), {});
-	for (const char* k : {"\"steps\"", "\"sightings_used\"", "\"sightings_rejected\"", "\"sightings_unknown_id\"",
-			 "\"time_per_step_ms\"", "\"ate_rmse_m\"", "\"max_error_m\"", "\"yaw_rmse_deg\"", "\"nees_mean\""})
+	for (const char* k :
+		 {"\"steps\"", "\"sightings_used\"", "\"sightings_rejected\"", "\"sightings_unknown_id\"",
+		  "\"time_per_step_ms\"", "\"ate_rmse_m\"", "\"max_error_m\"", "\"yaw_rmse_deg\"",
+		  "\"nees_mean\""})
 		EXPECT_NE(json.find(k), std::string::npos) << k;
 
 	// Bad input: one error naming the file.

@@ -15,14 +15,16 @@ using namespace codemark::filters;
 namespace
 {
 LocalizeSummary runOn(
-	bool obs_only, int max_frames, const std::string& method, const std::string& ini, bool slam_no_map = false)
+	bool obs_only, int max_frames, const std::string& method, const std::string& ini,
+	bool slam_no_map = false)
 {
 	sim::DatasetOptions o;
 	o.odometry_scale_error = 0.03;
 	o.seed = 3;
 	const auto dir = fs::temp_directory_path() /
-		("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao"));
-	if (!fs::exists(dir / "dataset.rawlog")) sim::writeDataset(o, dir.string(), obs_only, {}, max_frames);
+					 ("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao"));
+	if (!fs::exists(dir / "dataset.rawlog"))
+		sim::writeDataset(o, dir.string(), obs_only, {}, max_frames);
 	LocalizeRequest req;
 	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/" + ini;
 	req.rawlog = (dir / "dataset.rawlog").string();
@@ -48,16 +50,19 @@ void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_fa
 {
 	ASSERT_TRUE(s.metrics);
 	const auto& m = *s.metrics;
-	EXPECT_EQ(s.first_fix_step, 0);  // first fix at the first sighting (landmarks in view at the start)
+	EXPECT_EQ(
+		s.first_fix_step, 0);  // first fix at the first sighting (landmarks in view at the start)
 	EXPECT_EQ(m.matched, s.steps);
 	EXPECT_LE(m.ate_rmse_m, max_ate_m);
-	EXPECT_GT(m.nees_mean, m.nees_band_low / nees_factor) << "mean NEES below the 95% band: too pessimistic";
-	EXPECT_LT(m.nees_mean, m.nees_band_high * nees_factor) << "mean NEES above the 95% band: overconfident";
+	EXPECT_GT(m.nees_mean, m.nees_band_low / nees_factor)
+		<< "mean NEES below the 95% band: too pessimistic";
+	EXPECT_LT(m.nees_mean, m.nees_band_high * nees_factor)
+		<< "mean NEES above the 95% band: overconfident";
 	EXPECT_GT(s.sightings_used, s.steps / 2);
-	std::cout << s.method << ": " << s.steps << " steps, ATE " << m.ate_rmse_m << " m, max " << m.max_error_m
-			  << " m, yaw RMSE " << m.yaw_rmse_deg << " deg, NEES " << m.nees_mean << " in [" << m.nees_band_low
-			  << ", " << m.nees_band_high << "], used " << s.sightings_used << ", rejected "
-			  << s.sightings_rejected << "\n";
+	std::cout << s.method << ": " << s.steps << " steps, ATE " << m.ate_rmse_m << " m, max "
+			  << m.max_error_m << " m, yaw RMSE " << m.yaw_rmse_deg << " deg, NEES " << m.nees_mean
+			  << " in [" << m.nees_band_low << ", " << m.nees_band_high << "], used "
+			  << s.sightings_used << ", rejected " << s.sightings_rejected << "\n";
 }
 }  // namespace
 
@@ -87,8 +92,8 @@ TEST(FiltersSim, EkfSlamMapsTheRoomWithSmallLandmarkYawErrors)
 	EXPECT_LT(m.landmark_yaw_rmse_deg, 2.0);
 	EXPECT_LT(m.landmark_rmse_m, 0.08);
 	EXPECT_LT(m.ate_rmse_m, 0.08);
-	std::cout << "ekf-slam: ATE " << m.ate_rmse_m << " m (aligned), NEES " << m.nees_mean << ", landmarks "
-			  << m.landmarks_matched << ", landmark RMSE " << m.landmark_rmse_m << " m, yaw RMSE "
-			  << m.landmark_yaw_rmse_deg << " deg, used " << s.sightings_used << ", rejected "
-			  << s.sightings_rejected << "\n";
+	std::cout << "ekf-slam: ATE " << m.ate_rmse_m << " m (aligned), NEES " << m.nees_mean
+			  << ", landmarks " << m.landmarks_matched << ", landmark RMSE " << m.landmark_rmse_m
+			  << " m, yaw RMSE " << m.landmark_yaw_rmse_deg << " deg, used " << s.sightings_used
+			  << ", rejected " << s.sightings_rejected << "\n";
 }

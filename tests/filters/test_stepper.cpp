@@ -25,12 +25,14 @@ const double kT0 = 1700000000.0;
 
 std::string tempFile(const std::string& name)
 {
-	const auto dir = std::filesystem::temp_directory_path() / ("codemark_test_stepper_" + std::to_string(getpid()));
+	const auto dir = std::filesystem::temp_directory_path() /
+					 ("codemark_test_stepper_" + std::to_string(getpid()));
 	std::filesystem::create_directories(dir);
 	return (dir / name).string();
 }
 
-void writeRawlog(const std::string& path, const std::vector<mrpt::serialization::CSerializable::Ptr>& entries,
+void writeRawlog(
+	const std::string& path, const std::vector<mrpt::serialization::CSerializable::Ptr>& entries,
 	bool plain = false)
 {
 	if (plain)
@@ -75,7 +77,7 @@ TEST(Stepper, InterpolatePose)
 	EXPECT_NEAR(m.x(), 0.5, 1e-12);
 	EXPECT_NEAR(m.y(), 1.0, 1e-12);
 	EXPECT_NEAR(std::abs(m.phi()), M_PI, 1e-12);  // shortest arc across the cut
-	EXPECT_NEAR(interpolatePose(1.0, a, 2.0, b, 5.0).x(), 1.0, 1e-12);  // clamped
+	EXPECT_NEAR(interpolatePose(1.0, a, 2.0, b, 5.0).x(), 1.0, 1e-12);	// clamped
 }
 
 TEST(Stepper, ObservationsOnlyInterpolatesOdometryToTheImageTime)
@@ -91,7 +93,7 @@ TEST(Stepper, ObservationsOnlyInterpolatesOdometryToTheImageTime)
 		if (k == 6)
 		{
 			e.push_back(landmarksAt(kT0 + 0.71));
-			e.push_back(landmarksAt(kT0 + 0.71, "CAM2_LANDMARKS"));  // a second camera, same time
+			e.push_back(landmarksAt(kT0 + 0.71, "CAM2_LANDMARKS"));	 // a second camera, same time
 		}
 	}
 	e.push_back(landmarksAt(kT0 + 1.50));
@@ -136,20 +138,23 @@ TEST(Stepper, ObservationsOnlyInterpolatesOdometryToTheImageTime)
 
 TEST(Stepper, ActionsObservationsComposesTheActionsSinceTheLastFrame)
 {
-	auto act = [](const CPose2D& u) {
+	auto act = [](const CPose2D& u)
+	{
 		auto ac = mrpt::obs::CActionCollection::Create();
 		ac->insert(odometry(u, 0.01, 0.02));
 		return ac;
 	};
-	auto sf = [](double t) {
+	auto sf = [](double t)
+	{
 		auto f = mrpt::obs::CSensoryFrame::Create();
 		f->insert(landmarksAt(t));
 		return f;
 	};
 	const CPose2D u1(0.1, 0, 0.5), u2(0.2, 0.05, -0.1), u3(0.3, 0, 0);
 	const std::string path = tempFile("actions_observations.rawlog");
-	writeRawlog(path, {act(CPose2D()), sf(kT0), act(u1), mrpt::obs::CSensoryFrame::Create(), act(u2), sf(kT0 + 1),
-						  act(u3), sf(kT0 + 2)});
+	writeRawlog(
+		path, {act(CPose2D()), sf(kT0), act(u1), mrpt::obs::CSensoryFrame::Create(), act(u2),
+			   sf(kT0 + 1), act(u3), sf(kT0 + 2)});
 	RawlogStepper st(path);
 	RawlogStep s;
 	ASSERT_TRUE(st.next(s));
@@ -176,20 +181,23 @@ TEST(Stepper, ActionsObservationsComposesTheActionsSinceTheLastFrame)
 // observations still counts its action.
 TEST(Stepper, ActionsObservationsStepsCountTheActionsBeforeThem)
 {
-	auto act = [](const CPose2D& u) {
+	auto act = [](const CPose2D& u)
+	{
 		auto ac = mrpt::obs::CActionCollection::Create();
 		ac->insert(odometry(u, 0.01, 0.02));
 		return ac;
 	};
-	auto sf = [](double t) {
+	auto sf = [](double t)
+	{
 		auto f = mrpt::obs::CSensoryFrame::Create();
 		f->insert(landmarksAt(t));
 		return f;
 	};
 	const CPose2D u(0.1, 0, 0);
 	const std::string path = tempFile("actions_count.rawlog");
-	writeRawlog(path, {sf(kT0), act(u), sf(kT0 + 1), act(u), mrpt::obs::CSensoryFrame::Create(), act(u),
-						  sf(kT0 + 3)});
+	writeRawlog(
+		path, {sf(kT0), act(u), sf(kT0 + 1), act(u), mrpt::obs::CSensoryFrame::Create(), act(u),
+			   sf(kT0 + 3)});
 	RawlogStepper st(path);
 	RawlogStep s;
 	std::vector<long> actions, indices;
@@ -322,7 +330,7 @@ TEST(Stepper, DropsObliqueSightings)
 	auto lm = landmarksAt(kT0);
 	CObservationCodedLandmarks::TSighting t;
 	t.C_L = Eigen::Matrix3d::Identity() * 1e-4;
-	t.id = 1, t.L = Eigen::Vector3d(2.0, 0.2, 0.5);  // 40 deg: kept
+	t.id = 1, t.L = Eigen::Vector3d(2.0, 0.2, 0.5);	 // 40 deg: kept
 	lm->sightings.push_back(t);
 	t.id = 2, t.L = Eigen::Vector3d(2.0, -0.3, -1.0);  // 74 deg: dropped
 	lm->sightings.push_back(t);

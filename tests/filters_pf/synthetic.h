@@ -22,7 +22,8 @@ inline LandmarkMap room()
 {
 	LandmarkMap m;
 	int id = 1;
-	auto add = [&](double x, double y, double yaw) {
+	auto add = [&](double x, double y, double yaw)
+	{
 		MapLandmark l;
 		l.id = id++, l.x_m = x, l.y_m = y, l.z_m = 0.6, l.yaw_rad = yaw;
 		m.landmarks.push_back(l);
@@ -38,7 +39,7 @@ inline LandmarkMap room()
 inline mrpt::poses::CPose3D robotTCamera()
 {
 	return mrpt::poses::CPose3D(0.1, 0, 0.6, 0, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
 /** C_L of a sighting at range \a l2_m: 1% of the range, 0.2 deg bearing,
@@ -50,9 +51,9 @@ inline Eigen::Matrix3d sightingCov(double l2_m)
 		.asDiagonal();
 }
 
-/** The sightings (by a camera \a robot_T_camera) of \a map's landmarks in view (range 0.4..5 m, bearing
- * within +-25 deg, seen from the front within +-60 deg) from a robot at
- * \a world_T_robot; with noise drawn from C_L when \a rng is given. */
+/** The sightings (by a camera \a robot_T_camera) of \a map's landmarks in view (range 0.4..5 m,
+ * bearing within +-25 deg, seen from the front within +-60 deg) from a robot at \a world_T_robot;
+ * with noise drawn from C_L when \a rng is given. */
 inline CObservationCodedLandmarks::Ptr observe(
 	const mrpt::poses::CPose2D& world_T_robot, const LandmarkMap& map, std::mt19937* rng = nullptr,
 	double t = 0, const mrpt::poses::CPose3D& robot_T_camera = robotTCamera())

@@ -105,7 +105,8 @@ TEST(CodedLandmarksMap, SerializationRoundTrip)
 			EXPECT_EQ(a.scale, b.scale);
 			EXPECT_EQ(out->find(a.id), &b);
 		}
-		EXPECT_EQ(out->likelihoodOptions.outlier_probability, in.likelihoodOptions.outlier_probability);
+		EXPECT_EQ(
+			out->likelihoodOptions.outlier_probability, in.likelihoodOptions.outlier_probability);
 		EXPECT_EQ(out->likelihoodOptions.sigma_scale, in.likelihoodOptions.sigma_scale);
 		EXPECT_EQ(out->likelihoodOptions.max_range_m, in.likelihoodOptions.max_range_m);
 	}
@@ -146,7 +147,8 @@ TEST(CodedLandmarksMap, BuiltFromIniByMultiMetricMap)
 	const auto o = pft::observe(kPose, pft::room());
 	EXPECT_GT(
 		mm.computeObservationLikelihood(*o, CPose3D(kPose)),
-		mm.computeObservationLikelihood(*o, CPose3D(CPose2D(kPose.x() + 0.1, kPose.y(), kPose.phi()))));
+		mm.computeObservationLikelihood(
+			*o, CPose3D(CPose2D(kPose.x() + 0.1, kPose.y(), kPose.phi()))));
 	std::remove(file.c_str());
 
 	// A missing landmark file is an error, not an empty map.
@@ -163,8 +165,9 @@ TEST(CodedLandmarksMap, LikelihoodPeaksAtTheTruePose)
 	ASSERT_GE(o->sightings.size(), 2u);
 	const double at_truth = loglik(m, *o, kPose);
 	EXPECT_TRUE(std::isfinite(at_truth));
-	for (const auto& d : {CPose2D(0.03, 0, 0), CPose2D(0, -0.03, 0), CPose2D(0, 0, 0.02),
-						  CPose2D(-0.1, 0.05, -0.05), CPose2D(1, 1, 1)})
+	for (const auto& d :
+		 {CPose2D(0.03, 0, 0), CPose2D(0, -0.03, 0), CPose2D(0, 0, 0.02),
+		  CPose2D(-0.1, 0.05, -0.05), CPose2D(1, 1, 1)})
 		EXPECT_GT(at_truth, loglik(m, *o, kPose + d)) << d;
 }
 
@@ -180,12 +183,14 @@ TEST(CodedLandmarksMap, OutliersStayFiniteAndBounded)
 	ASSERT_TRUE(std::isfinite(with_outlier));
 	// The mixture's floor: log(p U), U = 1 / (max_range (2 pi)^2).
 	const auto& lo = m.likelihoodOptions;
-	const double floor = std::log(lo.outlier_probability) - std::log(lo.max_range_m * 4 * M_PI * M_PI);
+	const double floor =
+		std::log(lo.outlier_probability) - std::log(lo.max_range_m * 4 * M_PI * M_PI);
 	EXPECT_GE(with_outlier - clean, floor - 1e-9);
 	EXPECT_LT(with_outlier - clean, floor + 0.1);
 	// Without the uniform, the same outlier costs far more.
 	m.likelihoodOptions.outlier_probability = 0;
-	EXPECT_LT(loglik(m, *o, kPose) - loglik(m, *pft::observe(kPose, m.landmarks()), kPose), floor - 100);
+	EXPECT_LT(
+		loglik(m, *o, kPose) - loglik(m, *pft::observe(kPose, m.landmarks()), kPose), floor - 100);
 }
 
 TEST(CodedLandmarksMap, UnknownIdsChangeNothing)
@@ -195,7 +200,7 @@ TEST(CodedLandmarksMap, UnknownIdsChangeNothing)
 	const CPose2D other(3, 2.5, -1);
 	const double a = loglik(m, *o, kPose), b = loglik(m, *o, other);
 	auto s = o->sightings.front();
-	s.id = 200;  // not in the map
+	s.id = 200;	 // not in the map
 	s.L = {1.0, 0.1, 0.2};
 	o->sightings.push_back(s);
 	EXPECT_EQ(loglik(m, *o, kPose), a);
@@ -210,8 +215,8 @@ TEST(CodedLandmarksMap, BearingRangeLikelihoodPeaksAtTheTruth)
 	ASSERT_GE(br->sensedData.size(), 2u);
 	const double at_truth = loglik(m, *br, kPose);
 	ASSERT_TRUE(std::isfinite(at_truth));
-	for (const auto& d : {CPose2D(0.05, 0, 0), CPose2D(0, 0.05, 0), CPose2D(0, 0, 0.03),
-						  CPose2D(0.5, -0.5, 0.4)})
+	for (const auto& d :
+		 {CPose2D(0.05, 0, 0), CPose2D(0, 0.05, 0), CPose2D(0, 0, 0.03), CPose2D(0.5, -0.5, 0.4)})
 		EXPECT_GT(at_truth, loglik(m, *br, kPose + d)) << d;
 
 	// Without per-reading covariances: the sensor's standard deviations.
@@ -245,7 +250,7 @@ namespace
 {
 struct RunResult
 {
-	int frames_with_sightings_to_converge = -1;  //!< -1: never within 10 cm
+	int frames_with_sightings_to_converge = -1;	 //!< -1: never within 10 cm
 	double final_error_m = 1e9;
 	bool initialized = false;
 };
@@ -346,7 +351,7 @@ TEST(ParticleFilter, CountsUnknownIdsAndRejectsWrongSightings)
 	auto unknown = o->sightings.front();
 	unknown.id = 250;
 	auto wrong = o->sightings.front();
-	wrong.L[0] += 1.0;  // a planted sighting 1 m off
+	wrong.L[0] += 1.0;	// a planted sighting 1 m off
 	o->sightings.push_back(unknown);
 	o->sightings.push_back(wrong);
 	mrpt::obs::CSensoryFrame sf;
@@ -402,7 +407,8 @@ TEST(ParticleFilter, NonFiniteParticlesOrCovarianceThrow)
 // entry (the app prints it on one line and exits 1).
 TEST(ParticleFilter, NonFiniteStateInARunNamesTheRawlogEntry)
 {
-	const std::string dir = mrpt::system::getTempFileName() + "_pf_nonfinite_" + std::to_string(getpid());
+	const std::string dir =
+		mrpt::system::getTempFileName() + "_pf_nonfinite_" + std::to_string(getpid());
 	mrpt::system::createDirectory(dir);
 	pft::room().save(dir + "/map.txt");
 	const std::string rawlog = dir + "/in.rawlog";
@@ -414,11 +420,12 @@ TEST(ParticleFilter, NonFiniteStateInARunNamesTheRawlogEntry)
 			mrpt::obs::CActionCollection acts;
 			mrpt::obs::CActionRobotMovement2D a;
 			a.computeFromOdometry(CPose2D(0.05, 0, 0), pft::motionModel());
-			if (k == 2)  // entry #4: finite, absurd (not odometry: MRPT would
+			if (k == 2)	 // entry #4: finite, absurd (not odometry: MRPT would
 			{  // recompute the PDF from the raw reading when reading it)
 				a.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
 				a.poseChange = mrpt::poses::CPosePDFGaussian::Create(
-					CPose2D(1e308, 0, 0), mrpt::math::CMatrixDouble33(Eigen::Matrix3d::Identity() * 1e-4));
+					CPose2D(1e308, 0, 0),
+					mrpt::math::CMatrixDouble33(Eigen::Matrix3d::Identity() * 1e-4));
 			}
 			acts.insert(a);
 			ar << acts;
@@ -454,7 +461,8 @@ TEST(ParticleFilter, BadConfigurationThrows)
 	EXPECT_THROW(codemark::filters::makeLocalizer("pf", cfg, pft::room()), std::invalid_argument);
 	auto cfg2 = shippedConfig(1);
 	EXPECT_THROW(
-		codemark::filters::makeLocalizer("pf", cfg2, codemark::LandmarkMap()), std::invalid_argument);
+		codemark::filters::makeLocalizer("pf", cfg2, codemark::LandmarkMap()),
+		std::invalid_argument);
 	auto cfg3 = shippedConfig(1);
 	cfg3.write("MetricMap_codedLandmarksMap_00_likelihoodOpts", "outlier_probability", 1.5);
 	EXPECT_THROW(codemark::filters::makeLocalizer("pf", cfg3, pft::room()), std::invalid_argument);

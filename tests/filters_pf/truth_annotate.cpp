@@ -59,7 +59,8 @@ int main(int argc, char** argv)
 			{
 				auto img = sf->getObservationByClass<mrpt::obs::CObservationImage>();
 				if (!img) continue;
-				if (frame >= gt.size()) throw std::runtime_error("more images than ground-truth rows");
+				if (frame >= gt.size())
+					throw std::runtime_error("more images than ground-truth rows");
 				auto o = codemark::pftest::observe(gt[frame], map, &rng, 0, img->cameraPose);
 				o->timestamp = img->timestamp;
 				o->sensorLabel = img->sensorLabel + "_LANDMARKS";

@@ -32,10 +32,13 @@ namespace
 mrpt::poses::CPose3D cameraOnRobot()
 {
 	return mrpt::poses::CPose3D(0.1, 0.05, 0.4, 0.3, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
-Eigen::Matrix3d sigmaL(double l2) { return Eigen::Vector3d(1e-6 * l2 * l2, 1e-6, 4e-4).asDiagonal(); }
+Eigen::Matrix3d sigmaL(double l2)
+{
+	return Eigen::Vector3d(1e-6 * l2 * l2, 1e-6, 4e-4).asDiagonal();
+}
 
 // One coded sighting of \a lm from \a robot, with noise drawn from its C_L
 // (no noise when rng is null).
@@ -116,8 +119,10 @@ TEST(EkfSlamModel, ObservationJacobiansMatchNumeric)
 		slamObservation(robot, sensor, lm, &Hx, &Hy);
 		for (int j = 0; j < 3; ++j)
 		{
-			const auto fx = [&](const Eigen::Vector3d& x) { return slamObservation(x, sensor, lm); };
-			const auto fy = [&](const Eigen::Vector3d& y) { return slamObservation(robot, sensor, y); };
+			const auto fx = [&](const Eigen::Vector3d& x)
+			{ return slamObservation(x, sensor, lm); };
+			const auto fy = [&](const Eigen::Vector3d& y)
+			{ return slamObservation(robot, sensor, y); };
 			EXPECT_LT((Hx.col(j) - numericColumn(fx, robot, j)).norm(), 1e-6) << k << " " << j;
 			EXPECT_LT((Hy.col(j) - numericColumn(fy, lm, j)).norm(), 1e-6) << k << " " << j;
 		}
@@ -141,8 +146,10 @@ TEST(EkfSlamModel, InverseObservationJacobiansAndRoundTrip)
 		EXPECT_NEAR(wrapToPi(back[2] - z[2]), 0, 1e-9);
 		for (int j = 0; j < 3; ++j)
 		{
-			const auto fx = [&](const Eigen::Vector3d& x) { return slamInverseObservation(x, sensor, z); };
-			const auto fz = [&](const Eigen::Vector3d& y) { return slamInverseObservation(robot, sensor, y); };
+			const auto fx = [&](const Eigen::Vector3d& x)
+			{ return slamInverseObservation(x, sensor, z); };
+			const auto fz = [&](const Eigen::Vector3d& y)
+			{ return slamInverseObservation(robot, sensor, y); };
 			EXPECT_LT((Jx.col(j) - numericColumn(fx, robot, j)).norm(), 1e-6) << k << " " << j;
 			EXPECT_LT((Jz.col(j) - numericColumn(fz, z, j)).norm(), 1e-6) << k << " " << j;
 		}
@@ -155,10 +162,8 @@ TEST(EkfSlamModel, MatchesTheSpecGroundTruth)
 	const Eigen::Vector3d robot(1.0, -0.5, 0.4), lm(4.0, 1.0, M_PI - 0.2);
 	const mrpt::poses::CPose3D world_T_robot(robot[0], robot[1], 0, robot[2], 0, 0);
 	const mrpt::poses::CPose3D world_T_lm(lm[0], lm[1], 0.4, lm[2], 0, 0);
-	const SightingTruth t =
-		sightingTruth((world_T_robot + cameraOnRobot()) - world_T_lm);
-	const Eigen::Vector3d h =
-		slamObservation(robot, pose::cameraPlanarPose(cameraOnRobot()), lm);
+	const SightingTruth t = sightingTruth((world_T_robot + cameraOnRobot()) - world_T_lm);
+	const Eigen::Vector3d h = slamObservation(robot, pose::cameraPlanarPose(cameraOnRobot()), lm);
 	EXPECT_NEAR(h[0], t.L[0], 1e-9);
 	EXPECT_NEAR(wrapToPi(h[1] - t.L[1]), 0, 1e-9);
 	EXPECT_NEAR(wrapToPi(h[2] - t.L[2]), 0, 1e-9);
@@ -183,7 +188,8 @@ TEST(EkfSlam, StaticRobotOneLandmarkConverges)
 	EXPECT_EQ(slam.landmarkDimension(), 3u);
 	const MappedLandmark m = slam.landmarks()[0];
 	EXPECT_EQ(m.landmark.id, 5);
-	const Eigen::Vector3d err(m.landmark.x_m - lm[0], m.landmark.y_m - lm[1], wrapToPi(m.landmark.yaw_rad - lm[2]));
+	const Eigen::Vector3d err(
+		m.landmark.x_m - lm[0], m.landmark.y_m - lm[1], wrapToPi(m.landmark.yaw_rad - lm[2]));
 	// Within 4 sigma of the final covariance, which shrank ~1/200 of one sighting's.
 	EXPECT_LT(err.dot(m.cov.ldlt().solve(err)), 16.0 * 3);
 	EXPECT_LT(std::sqrt(m.cov(0, 0)), 0.001);
@@ -198,7 +204,7 @@ TEST(EkfSlam, StaticRobotOneLandmarkConverges)
 Eigen::Matrix3d correlatedC(double l2, double t)
 {
 	Eigen::Matrix3d A;
-	A << 0.004 * l2, 0.0, 0.0,  //
+	A << 0.004 * l2, 0.0, 0.0,	//
 		0.0008 * std::cos(t), 0.001, 0.0,  //
 		0.015 * std::sin(t), 0.004 * std::cos(t), 0.006;
 	return A * A.transpose();
@@ -234,8 +240,9 @@ TEST(EkfSlam, OneLandmarkCorrelatedNoiseIsConsistent)
 				{
 					// The true motion differs from the odometry by its noise.
 					const auto r = mrpt::poses::CPose2D(robot[0], robot[1], robot[2]) +
-						mrpt::poses::CPose2D(inc.x() + sigma_odo * n(rng), inc.y() + sigma_odo * n(rng),
-							inc.phi() + sigma_odo * n(rng));
+								   mrpt::poses::CPose2D(
+									   inc.x() + sigma_odo * n(rng), inc.y() + sigma_odo * n(rng),
+									   inc.phi() + sigma_odo * n(rng));
 					robot = Eigen::Vector3d(r.x(), r.y(), r.phi());
 				}
 				CObservationCodedLandmarks::TSighting s;
@@ -251,7 +258,8 @@ TEST(EkfSlam, OneLandmarkCorrelatedNoiseIsConsistent)
 			}
 			const MappedLandmark m = slam.landmarks().at(0);
 			const Eigen::Vector3d e(
-				m.landmark.x_m - lm[0], m.landmark.y_m - lm[1], wrapToPi(m.landmark.yaw_rad - lm[2]));
+				m.landmark.x_m - lm[0], m.landmark.y_m - lm[1],
+				wrapToPi(m.landmark.yaw_rad - lm[2]));
 			nees_lm += e.dot(m.cov.ldlt().solve(e));
 			yaw_err_max = std::max(yaw_err_max, std::abs(e[2]));
 			const PoseEstimate r = slam.estimate();
@@ -267,7 +275,8 @@ TEST(EkfSlam, OneLandmarkCorrelatedNoiseIsConsistent)
 		EXPECT_LT(nees_robot / runs, 3.6) << method;
 		EXPECT_LT(yaw_err_max, 0.05) << method;
 		std::cout << method << ": landmark NEES " << nees_lm / runs << ", robot NEES "
-				  << nees_robot / runs << ", largest landmark yaw error " << yaw_err_max << " rad\n";
+				  << nees_robot / runs << ", largest landmark yaw error " << yaw_err_max
+				  << " rad\n";
 	}
 }
 
@@ -339,7 +348,7 @@ TEST(EkfSlam, AngleWrapAtPi)
 		EXPECT_EQ(st.rejected, 0) << k;
 		const auto e = slam.estimate();
 		EXPECT_NEAR(wrapToPi(e.mean.phi() - robot[2]), 0, 0.01) << k;
-		EXPECT_GT(std::abs(e.mean.phi()), 3.0);  // wrapped, never near 2 pi
+		EXPECT_GT(std::abs(e.mean.phi()), 3.0);	 // wrapped, never near 2 pi
 	}
 	const auto m = slam.landmarks()[0];
 	EXPECT_NEAR(wrapToPi(m.landmark.yaw_rad - lm[2]), 0, 0.05);
@@ -353,7 +362,8 @@ TEST(EkfSlam, CovarianceStaysSymmetricPositiveDefinite)
 	std::uniform_real_distribution<double> u(-1, 1);
 	std::vector<Eigen::Vector3d> lms;
 	for (int i = 0; i < 8; ++i)
-		lms.emplace_back(4 * std::cos(i * M_PI / 4), 4 * std::sin(i * M_PI / 4), wrapToPi(i * M_PI / 4 + M_PI));
+		lms.emplace_back(
+			4 * std::cos(i * M_PI / 4), 4 * std::sin(i * M_PI / 4), wrapToPi(i * M_PI / 4 + M_PI));
 	EkfSlam slam(EkfSlamOptions{}, LandmarkMap{}, std::nullopt);
 	Eigen::Vector3d robot(0, 0, 0);
 	const mrpt::poses::CPose2D cam = pose::cameraPlanarPose(cameraOnRobot());
@@ -368,7 +378,7 @@ TEST(EkfSlam, CovarianceStaysSymmetricPositiveDefinite)
 			const Eigen::Vector3d z = slamObservation(robot, cam, lms[i]);
 			if (std::abs(z[1]) > 0.6 || std::abs(z[2]) > 1.2) continue;
 			auto s = sight(i, robot, lms[i], &rng);
-			if (u(rng) > 0.95) s.L[0] += 0.5 * u(rng);  // occasional garbage
+			if (u(rng) > 0.95) s.L[0] += 0.5 * u(rng);	// occasional garbage
 			ss.push_back(s);
 		}
 		const auto act = motion(inc, 0.01);
@@ -523,7 +533,8 @@ TEST(EkfSlam, KfSlamDemoPathWithinOneCentimetre)
 TEST(EkfSlam, KfSlamDemoRunMatchesGroundTruthRowsByActionCount)
 {
 	const std::string ds = "/usr/share/mrpt/datasets/";
-	if (!std::ifstream(ds + "kf-slam_demo.rawlog")) GTEST_SKIP() << "mrpt-common datasets not installed";
+	if (!std::ifstream(ds + "kf-slam_demo.rawlog"))
+		GTEST_SKIP() << "mrpt-common datasets not installed";
 	LocalizeRequest req;
 	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/ekf-slam.ini";
 	req.method = "ekf-slam";
@@ -532,7 +543,7 @@ TEST(EkfSlam, KfSlamDemoRunMatchesGroundTruthRowsByActionCount)
 	const auto s = runLocalization(req);
 	EXPECT_EQ(s.steps, 250);  // 249 action-observation pairs + the leading frame
 	ASSERT_TRUE(s.metrics);
-	EXPECT_EQ(s.metrics->matched, 250);  // 250 ground-truth rows, row 0 included
+	EXPECT_EQ(s.metrics->matched, 250);	 // 250 ground-truth rows, row 0 included
 	ASSERT_FALSE(s.rows.empty());
 	ASSERT_TRUE(s.rows.front().truth);
 	EXPECT_EQ(s.rows.front().truth->x(), 0.0);

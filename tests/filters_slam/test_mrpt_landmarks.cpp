@@ -22,7 +22,8 @@ int failingLine(const std::string& text)
 	catch (const MapFileError& e)
 	{
 		EXPECT_EQ(e.file(), "x.txt");
-		EXPECT_NE(std::string(e.what()).find("x.txt:" + std::to_string(e.line())), std::string::npos);
+		EXPECT_NE(
+			std::string(e.what()).find("x.txt:" + std::to_string(e.line())), std::string::npos);
 		return e.line();
 	}
 	return 0;
@@ -51,13 +52,13 @@ TEST(MrptLandmarks, ParsesRowsCommentsAndBlankLines)
 
 TEST(MrptLandmarks, BadLinesAreNamed)
 {
-	EXPECT_EQ(failingLine("1 2 0 5 0 0 1\n1 2 0 5 0 1\n"), 2);  // 6 columns
-	EXPECT_EQ(failingLine("1 2 0 5 0 0 1 7\n"), 1);  // 8 columns
+	EXPECT_EQ(failingLine("1 2 0 5 0 0 1\n1 2 0 5 0 1\n"), 2);	// 6 columns
+	EXPECT_EQ(failingLine("1 2 0 5 0 0 1 7\n"), 1);	 // 8 columns
 	EXPECT_EQ(failingLine("% c\n1 abc 0 5 0 0 1\n"), 2);  // not a number
-	EXPECT_EQ(failingLine("1 2 0 5 0 0 1.5\n"), 1);  // non-integer ID
-	EXPECT_EQ(failingLine("1 2 0 5 0 0 -3\n"), 1);  // negative ID
-	EXPECT_EQ(failingLine("1 2 0 5 0 0 3\n\n4 5 0 5 0 0 3\n"), 3);  // duplicate
-	EXPECT_EQ(failingLine("1 nan 0 5 0 0 3\n"), 1);  // not finite
+	EXPECT_EQ(failingLine("1 2 0 5 0 0 1.5\n"), 1);	 // non-integer ID
+	EXPECT_EQ(failingLine("1 2 0 5 0 0 -3\n"), 1);	// negative ID
+	EXPECT_EQ(failingLine("1 2 0 5 0 0 3\n\n4 5 0 5 0 0 3\n"), 3);	// duplicate
+	EXPECT_EQ(failingLine("1 nan 0 5 0 0 3\n"), 1);	 // not finite
 	EXPECT_EQ(failingLine("1 2 0 5 0 0 3\n"), 0);
 }
 

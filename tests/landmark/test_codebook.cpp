@@ -24,7 +24,7 @@ TEST(Codebook, SpecBitOrder)
 	const CodeCells c1 = encodeId(1);
 	EXPECT_TRUE(c1[2][2]);
 	EXPECT_FALSE(c1[0][0]);
-	const CodeCells c16 = encodeId(16);  // bit 4: r1c0
+	const CodeCells c16 = encodeId(16);	 // bit 4: r1c0
 	EXPECT_TRUE(c16[1][0]);
 	EXPECT_FALSE(c16[1][2]);
 	const CodeCells c8 = encodeId(8);  // bit 3: r1c2

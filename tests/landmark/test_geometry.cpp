@@ -13,14 +13,16 @@ TEST(Geometry, ReferencePointsAsSeenFromTheFront)
 	const auto p = g.referencePoints();
 	// Frame L: X_L out of the wall, Y_L to the observer's right, Z_L up.
 	for (const auto& q : p) EXPECT_DOUBLE_EQ(q.x(), 0.0);
-	EXPECT_DOUBLE_EQ(p[0].y(), -0.08);  // top-left
+	EXPECT_DOUBLE_EQ(p[0].y(), -0.08);	// top-left
 	EXPECT_DOUBLE_EQ(p[0].z(), 0.08);
 	EXPECT_DOUBLE_EQ(p[1].y(), 0.08);  // top-right
-	EXPECT_DOUBLE_EQ(p[2].z(), -0.08);  // bottom-right
-	EXPECT_DOUBLE_EQ(p[3].y(), -0.08);  // bottom-left
+	EXPECT_DOUBLE_EQ(p[2].z(), -0.08);	// bottom-right
+	EXPECT_DOUBLE_EQ(p[3].y(), -0.08);	// bottom-left
 	EXPECT_DOUBLE_EQ(p[3].z(), -0.08);
 	// Y_L = Z_L x X_L.
-	EXPECT_TRUE(Eigen::Vector3d::UnitZ().cross(Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+	EXPECT_TRUE(Eigen::Vector3d::UnitZ()
+					.cross(Eigen::Vector3d::UnitX())
+					.isApprox(Eigen::Vector3d::UnitY()));
 }
 
 TEST(Geometry, ScaleKeepsProportions)
@@ -46,7 +48,7 @@ TEST(Geometry, IniRoundTripAndValidation)
 	EXPECT_DOUBLE_EQ(back.outer_size_m, 0.4);
 
 	mrpt::config::CConfigFileMemory bad;
-	bad.write("LANDMARK", "inner_size_m", 0.3);  // larger than the outer edge
+	bad.write("LANDMARK", "inner_size_m", 0.3);	 // larger than the outer edge
 	LandmarkGeometry b;
 	EXPECT_THROW(b.loadFromConfigFile(bad, "LANDMARK"), std::invalid_argument);
 }

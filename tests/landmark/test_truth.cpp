@@ -33,7 +33,8 @@ TEST(Truth, SignsFollowTheSpec)
 	auto t = sightingTruth(levelCamera(2 * std::cos(a), 2 * std::sin(a), 0, M_PI + a));
 	EXPECT_NEAR(t.L[1], 0.0, 1e-12);
 	EXPECT_NEAR(t.L[2], a, 1e-12);
-	// Turning the camera to the right (clockwise) puts the landmark on the left of the image: phi1 > 0.
+	// Turning the camera to the right (clockwise) puts the landmark on the left of the image: phi1
+	// > 0.
 	t = sightingTruth(levelCamera(2, 0, 0, M_PI - 0.1));
 	EXPECT_NEAR(t.L[1], 0.1, 1e-12);
 	EXPECT_NEAR(t.L[2], -0.1, 1e-12);

@@ -49,7 +49,8 @@ CObservationCodedLandmarks makeFilled()
 		s.quality.code_margin = 55.5;
 		s.quality.area_px = 3300;
 		s.quality.corner_sigma_px = 0.02;
-		s.method = k ? codemark::pose::PoseMethod::General6Dof : codemark::pose::PoseMethod::ClosedForm;
+		s.method =
+			k ? codemark::pose::PoseMethod::General6Dof : codemark::pose::PoseMethod::ClosedForm;
 		o.sightings.push_back(s);
 	}
 	return o;
@@ -95,7 +96,8 @@ TEST(CodedLandmarksObs, RoundTripDefaultAndFilled)
 {
 	for (const auto& o : {CObservationCodedLandmarks(), makeFilled()})
 	{
-		auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(codemark::test::toBytes(o)));
+		auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(
+			codemark::test::fromBytes(codemark::test::toBytes(o)));
 		ASSERT_TRUE(back);
 		expectSame(o, *back);
 	}
@@ -106,12 +108,14 @@ TEST(CodedLandmarksObs, GoldenFileStaysReadable)
 	if (std::getenv("CODEMARK_WRITE_GOLDEN"))
 	{
 		const auto b = codemark::test::toBytes(makeFilled());
-		std::ofstream(kGolden, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), b.size());
+		std::ofstream(kGolden, std::ios::binary)
+			.write(reinterpret_cast<const char*>(b.data()), b.size());
 	}
 	std::ifstream f(kGolden, std::ios::binary);
 	ASSERT_TRUE(f.good()) << kGolden;
 	const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), {});
-	auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(bytes));
+	auto back =
+		std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(bytes));
 	ASSERT_TRUE(back);
 	expectSame(makeFilled(), *back);
 }
@@ -135,7 +139,8 @@ TEST(CodedLandmarksObs, BitFlipsNeverCrash)
 	{
 		auto f = b;
 		const int flips = 1 + trial % 4;
-		for (int k = 0; k < flips; ++k) f[rng() % f.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
+		for (int k = 0; k < flips; ++k)
+			f[rng() % f.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
 		try
 		{
 			auto o = codemark::test::fromBytes(f);
@@ -204,7 +209,7 @@ TEST(CodedLandmarksObs, CameraHeadingFromOpticalPose)
 {
 	// A camera turned 30 deg to the left on the robot.
 	const auto cam = mrpt::poses::CPose3D(0, 0, 0.5, M_PI / 6, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+					 mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	EXPECT_NEAR(codemark::xForwardPoseOfCamera(cam).yaw(), M_PI / 6, 1e-12);
 }
 
@@ -230,6 +235,7 @@ TEST(CodedLandmarksObs, NonFiniteMeasurementIsCorruptData)
 		if (field == 0) s.L.x() = std::numeric_limits<double>::quiet_NaN();
 		if (field == 1) s.P(2) = std::numeric_limits<double>::infinity();
 		if (field == 2) s.C_L(1, 1) = -std::numeric_limits<double>::infinity();
-		EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o))) << "field " << field;
+		EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)))
+			<< "field " << field;
 	}
 }

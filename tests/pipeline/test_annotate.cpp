@@ -26,7 +26,8 @@ std::string freshDir(const std::string& name)
 {
 	// One folder per process: ctest runs each TEST in its own process, in
 	// parallel, and the shared dataset must not be rewritten under a reader.
-	const std::string d = ::testing::TempDir() + "codemark_pipeline_" + std::to_string(getpid()) + "_" + name;
+	const std::string d =
+		::testing::TempDir() + "codemark_pipeline_" + std::to_string(getpid()) + "_" + name;
 	mrpt::system::deleteFilesInDirectory(d, true);
 	mrpt::system::createDirectory(d);
 	return d;
@@ -45,7 +46,7 @@ const Dataset& dataset(bool obs_only)
 	if (it != cache.end()) return it->second;
 	Dataset d;
 	d.dir = freshDir(obs_only ? "obs" : "ao");
-	sim::DatasetOptions o;  // the realistic defaults: texture, noise 2, blur 0.8
+	sim::DatasetOptions o;	// the realistic defaults: texture, noise 2, blur 0.8
 	o.seed = 7;
 	d.sum = sim::writeDataset(o, d.dir, obs_only, {}, 80);
 	return cache[obs_only] = d;
@@ -90,8 +91,10 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 		ASSERT_TRUE(sf);
 		ASSERT_EQ(sf->size(), 2u);
 		// The landmark observation comes right after its image.
-		auto img = std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(sf->getObservationByIndex(0));
-		auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(sf->getObservationByIndex(1));
+		auto img =
+			std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(sf->getObservationByIndex(0));
+		auto lm =
+			std::dynamic_pointer_cast<CObservationCodedLandmarks>(sf->getObservationByIndex(1));
 		ASSERT_TRUE(img && lm);
 		EXPECT_EQ(lm->sensorLabel, "CAM_LANDMARKS");
 		EXPECT_EQ(lm->timestamp, img->timestamp);
@@ -122,7 +125,8 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 	for (int far = 0; far < 2; ++far)
 		if (count[far])
 			std::printf(
-				"%s: %d sightings; error/sigma mean (bias) and RMS: l2 %+.2f %.2f, phi1 %+.2f %.2f, "
+				"%s: %d sightings; error/sigma mean (bias) and RMS: l2 %+.2f %.2f, phi1 %+.2f "
+				"%.2f, "
 				"phi2 %+.2f %.2f\n",
 				far ? ">= 2 m" : "< 2 m", count[far], sum[far][0] / count[far],
 				std::sqrt(sum2[far][0] / count[far]), sum[far][1] / count[far],
@@ -170,9 +174,12 @@ TEST(Annotate, BadInputsStopWithTheEntryIndex)
 	const auto& d = dataset(false);
 	const std::string dir = freshDir("bad");
 	pipeline::AnnotateOptions o;
-	EXPECT_THROW(pipeline::annotateRawlog(dir + "/missing.rawlog", dir + "/o.rawlog", o), std::runtime_error);
+	EXPECT_THROW(
+		pipeline::annotateRawlog(dir + "/missing.rawlog", dir + "/o.rawlog", o),
+		std::runtime_error);
 	std::ofstream(dir + "/empty.rawlog").close();
-	EXPECT_THROW(pipeline::annotateRawlog(dir + "/empty.rawlog", dir + "/o.rawlog", o), std::runtime_error);
+	EXPECT_THROW(
+		pipeline::annotateRawlog(dir + "/empty.rawlog", dir + "/o.rawlog", o), std::runtime_error);
 
 	// A truncated copy (uncompressed, cut in the middle of an entry).
 	{

@@ -30,7 +30,9 @@ namespace
 std::pair<double, double> neesBand(int n)
 {
 	const double k = 3.0 * n, h = 2.0 / (9 * k), z = 1.959963984540054;
-	return {k * std::pow(1 - h - z * std::sqrt(h), 3) / n, k * std::pow(1 - h + z * std::sqrt(h), 3) / n};
+	return {
+		k * std::pow(1 - h - z * std::sqrt(h), 3) / n,
+		k * std::pow(1 - h + z * std::sqrt(h), 3) / n};
 }
 
 struct NeesResult
@@ -43,67 +45,69 @@ struct NeesResult
 // The renders, detections and NEES of both paths, computed once.
 const NeesResult& neesOnRenders()
 {
-	static const NeesResult result = [] {
-	NeesResult out;
-	sim::Scene scene;
-	MapLandmark lm;
-	lm.id = 37;
-	lm.z_m = 0.5;
-	scene.map.landmarks.push_back(lm);
-	scene.camera = CameraModel::paperDefault();
-	// The calibration's conditions: textured wall, light gradient, noise 2,
-	// blur 0.8 px.
-	const sim::RenderOptions ro = sim::DatasetOptions::realisticRender();
-	const LandmarkGeometry g = lm.geometry();
-	const detect::DetectorOptions dopt;
-	pose::PoseOptions cf = pipeline::detectorCalibratedPoseOptions(), gen = cf;
-	cf.method = pose::PoseMethod::ClosedForm;
-	gen.method = pose::PoseMethod::General6Dof;
+	static const NeesResult result = []
+	{
+		NeesResult out;
+		sim::Scene scene;
+		MapLandmark lm;
+		lm.id = 37;
+		lm.z_m = 0.5;
+		scene.map.landmarks.push_back(lm);
+		scene.camera = CameraModel::paperDefault();
+		// The calibration's conditions: textured wall, light gradient, noise 2,
+		// blur 0.8 px.
+		const sim::RenderOptions ro = sim::DatasetOptions::realisticRender();
+		const LandmarkGeometry g = lm.geometry();
+		const detect::DetectorOptions dopt;
+		pose::PoseOptions cf = pipeline::detectorCalibratedPoseOptions(), gen = cf;
+		cf.method = pose::PoseMethod::ClosedForm;
+		gen.method = pose::PoseMethod::General6Dof;
 
-	std::mt19937_64 rng(20261122);  // not a calibration seed
-	std::uniform_real_distribution<double> U(0, 1);
-	const int renders = 320;
-	double sum[2] = {0, 0};
-	int used[2] = {0, 0}, detected = 0, visible = 0;
-	for (int i = 0; i < renders; ++i)
-	{
-		const double r0 = 0.5, r1 = 4.0;
-		const double d = std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
-		const double a = (2 * U(rng) - 1) * 65 * M_PI / 180;
-		const double bearing = (2 * U(rng) - 1) * 0.35, height = (2 * U(rng) - 1) * 0.5;
-		scene.world_T_camera = sim::levelCameraLookingAt(lm, d, a, height, bearing);
-		const sim::Render img = sim::render(scene, ro, 5000 + i);
-		if (!img.truth[0].fully_visible) continue;
-		++visible;
-		const SightingTruth truth = sightingTruth(img.truth[0].landmark_T_camera);
-		for (const auto& dl : detect::detect(img.image, scene.camera, g, dopt).landmarks)
+		std::mt19937_64 rng(20261122);	// not a calibration seed
+		std::uniform_real_distribution<double> U(0, 1);
+		const int renders = 320;
+		double sum[2] = {0, 0};
+		int used[2] = {0, 0}, detected = 0, visible = 0;
+		for (int i = 0; i < renders; ++i)
 		{
-			if (dl.detection.id != lm.id) continue;
-			++detected;
-			int k = 0;
-			for (const pose::PoseOptions* o : {&cf, &gen})
+			const double r0 = 0.5, r1 = 4.0;
+			const double d = std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
+			const double a = (2 * U(rng) - 1) * 65 * M_PI / 180;
+			const double bearing = (2 * U(rng) - 1) * 0.35, height = (2 * U(rng) - 1) * 0.5;
+			scene.world_T_camera = sim::levelCameraLookingAt(lm, d, a, height, bearing);
+			const sim::Render img = sim::render(scene, ro, 5000 + i);
+			if (!img.truth[0].fully_visible) continue;
+			++visible;
+			const SightingTruth truth = sightingTruth(img.truth[0].landmark_T_camera);
+			for (const auto& dl : detect::detect(img.image, scene.camera, g, dopt).landmarks)
 			{
-				const pose::Measurement m = pose::measure(dl.detection.corners, scene.camera, g, *o);
-				if (std::sqrt(m.C_L(2, 2)) <= 2 * M_PI / 180)
+				if (dl.detection.id != lm.id) continue;
+				++detected;
+				int k = 0;
+				for (const pose::PoseOptions* o : {&cf, &gen})
 				{
-					Eigen::Vector3d e = m.pose_in_landmark - truth.pose_in_landmark;
-					e[2] = wrapToPi(e[2]);
-					sum[k] += e.dot(m.C_R.ldlt().solve(e));
-					++used[k];
+					const pose::Measurement m =
+						pose::measure(dl.detection.corners, scene.camera, g, *o);
+					if (std::sqrt(m.C_L(2, 2)) <= 2 * M_PI / 180)
+					{
+						Eigen::Vector3d e = m.pose_in_landmark - truth.pose_in_landmark;
+						e[2] = wrapToPi(e[2]);
+						sum[k] += e.dot(m.C_R.ldlt().solve(e));
+						++used[k];
+					}
+					++k;
 				}
-				++k;
+				break;
 			}
-			break;
 		}
-	}
-	for (int k = 0; k < 2; ++k)
-	{
-		out.used[k] = used[k];
-		out.mean[k] = used[k] ? sum[k] / used[k] : 0;
-	}
-	out.detected = detected;
-	out.visible = visible;
-	return out;
+		for (int k = 0; k < 2; ++k)
+		{
+			out.used[k] = used[k];
+			out.mean[k] = used[k] ? sum[k] / used[k] : 0;
+		}
+		out.detected = detected;
+		out.visible = visible;
+		return out;
 	}();
 	return result;
 }
@@ -113,7 +117,8 @@ void checkNees(int k)
 	const NeesResult& r = neesOnRenders();
 	EXPECT_GE(r.detected, 0.95 * r.visible);
 	const auto [lo, hi] = neesBand(std::max(1, r.used[k]));
-	std::printf("[ NEES ] %s: mean %.3f over %d sightings (%d detected), 95%% band [%.3f, %.3f]\n",
+	std::printf(
+		"[ NEES ] %s: mean %.3f over %d sightings (%d detected), 95%% band [%.3f, %.3f]\n",
 		k ? "General6Dof" : "ClosedForm", r.mean[k], r.used[k], r.detected, lo, hi);
 	ASSERT_GE(r.used[k], 200) << "too few sightings with a predicted phi2 sigma <= 2 deg";
 	EXPECT_GT(r.mean[k], lo);
@@ -165,15 +170,23 @@ TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 			{
 				pose::PoseOptions o = pipeline::detectorCalibratedPoseOptions();
 				o.method = method;
-				const pose::Measurement m = pose::measure(det.landmarks[0].detection.corners, scene.camera, g, o);
-				const std::string what = pose::toString(method) + " at " + std::to_string(d) + " m, " +
-					std::to_string(deg) + " deg";
+				const pose::Measurement m =
+					pose::measure(det.landmarks[0].detection.corners, scene.camera, g, o);
+				const std::string what = pose::toString(method) + " at " + std::to_string(d) +
+										 " m, " + std::to_string(deg) + " deg";
 				EXPECT_NEAR(m.L[0], t.L[0], 1e-3 * t.L[0]) << what;
 				EXPECT_NEAR(wrapToPi(m.L[1] - t.L[1]), 0, 1e-3) << what;
 				EXPECT_NEAR(wrapToPi(m.L[2] - t.L[2]), 0, 3 * std::sqrt(m.C_L(2, 2))) << what;
-				EXPECT_NEAR(m.pose_in_landmark[0], t.pose_in_landmark[0], 3 * std::sqrt(m.C_R(0, 0))) << what;
-				EXPECT_NEAR(m.pose_in_landmark[1], t.pose_in_landmark[1], 3 * std::sqrt(m.C_R(1, 1))) << what;
-				EXPECT_NEAR(wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]), 0, 3 * std::sqrt(m.C_R(2, 2))) << what;
+				EXPECT_NEAR(
+					m.pose_in_landmark[0], t.pose_in_landmark[0], 3 * std::sqrt(m.C_R(0, 0)))
+					<< what;
+				EXPECT_NEAR(
+					m.pose_in_landmark[1], t.pose_in_landmark[1], 3 * std::sqrt(m.C_R(1, 1)))
+					<< what;
+				EXPECT_NEAR(
+					wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]), 0,
+					3 * std::sqrt(m.C_R(2, 2)))
+					<< what;
 			}
 		}
 	EXPECT_EQ(n, 16);

@@ -16,7 +16,7 @@ namespace codemark::test
 inline mrpt::poses::CPose3D levelCamera(double x, double y, double z, double heading)
 {
 	return mrpt::poses::CPose3D(x, y, z, heading, 0, 0) +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
 /** A camera at distance \a d from the landmark centre, on the line of sight

@@ -45,8 +45,8 @@ struct Config
 std::vector<Config> randomConfigs(int n, uint32_t seed)
 {
 	std::mt19937 rng(seed);
-	std::uniform_real_distribution<double> d(0.4, 6.0), a(-1.3, 1.3), z(-0.5, 0.5),
-		p1(-0.3, 0.3), s(0.5, 2.0);
+	std::uniform_real_distribution<double> d(0.4, 6.0), a(-1.3, 1.3), z(-0.5, 0.5), p1(-0.3, 0.3),
+		s(0.5, 2.0);
 	std::vector<Config> out;
 	for (int i = 0; i < n; ++i) out.push_back({d(rng), a(rng), z(rng), p1(rng), s(rng)});
 	// Exactly frontal (y1 = y2) and strongly oblique cases.
@@ -67,7 +67,8 @@ TEST(ClosedForm, MatchesGeometricTruth)
 		const CPose3D landmark_T_camera = cameraAt(c.d, c.angle, c.z, c.phi1);
 		const SightingTruth truth = sightingTruth(landmark_T_camera);
 		double lambda = 0;
-		const Eigen::Vector4d P = primaryMeasurement(projectCorners(landmark_T_camera, cam, g), cam, &lambda);
+		const Eigen::Vector4d P =
+			primaryMeasurement(projectCorners(landmark_T_camera, cam, g), cam, &lambda);
 		const Eigen::Vector3d L = landmarkFromPrimary(P, lambda, g.innerHalf());
 		EXPECT_NEAR(L[0], truth.L[0], 1e-9 * truth.L[0]) << "d " << c.d << " angle " << c.angle;
 		EXPECT_NEAR(L[1], truth.L[1], 1e-9);
@@ -89,8 +90,10 @@ TEST(ClosedForm, SignsOnSimpleCases)
 	// (observer's left), its axis turned clockwise from the inward normal.
 	const Eigen::Vector3d L2 = landmarkFromPrimary(Eigen::Vector4d(-20, 40, 20, 42), 800, 0.08);
 	EXPECT_GT(L2[2], 0);
-	EXPECT_THROW(landmarkFromPrimary(Eigen::Vector4d(0, 0, 10, 10), 800, 0.08), std::invalid_argument);
-	EXPECT_THROW(landmarkFromPrimary(Eigen::Vector4d(0, 10, 10, -1), 800, 0.08), std::invalid_argument);
+	EXPECT_THROW(
+		landmarkFromPrimary(Eigen::Vector4d(0, 0, 10, 10), 800, 0.08), std::invalid_argument);
+	EXPECT_THROW(
+		landmarkFromPrimary(Eigen::Vector4d(0, 10, 10, -1), 800, 0.08), std::invalid_argument);
 }
 
 TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
@@ -100,8 +103,8 @@ TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
 	{
 		const LandmarkGeometry g = LandmarkGeometry::scaled(c.scale);
 		double lambda = 0;
-		const Eigen::Vector4d P =
-			primaryMeasurement(projectCorners(cameraAt(c.d, c.angle, c.z, c.phi1), cam, g), cam, &lambda);
+		const Eigen::Vector4d P = primaryMeasurement(
+			projectCorners(cameraAt(c.d, c.angle, c.z, c.phi1), cam, g), cam, &lambda);
 		Eigen::Matrix<double, 3, 4> J;
 		landmarkFromPrimary(P, lambda, g.innerHalf(), &J);
 		Eigen::Matrix<double, 3, 4> Jn;
@@ -113,7 +116,7 @@ TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
 			b[k] -= h;
 			Jn.col(k) = (landmarkFromPrimary(a, lambda, g.innerHalf()) -
 						 landmarkFromPrimary(b, lambda, g.innerHalf())) /
-				(2 * h);
+						(2 * h);
 		}
 		expectJacobianNear(J, Jn, 1e-6, "J_P");
 	}
@@ -186,8 +189,8 @@ TEST(Composition, RobotWorldPoseRecoveredExactly)
 			CPose3D(0.2 * u(rng), 0.1 * u(rng), 0.6 + 0.3 * u(rng), mount_yaw, 0, 0) +
 			CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 		// The robot placed so that the camera sees the landmark from the front.
-		const CPose3D landmark_T_camera = cameraAt(1 + 2 * std::abs(u(rng)), 0.8 * u(rng),
-			robot_T_camera.z() - lm.z_m, 0.2 * u(rng));
+		const CPose3D landmark_T_camera = cameraAt(
+			1 + 2 * std::abs(u(rng)), 0.8 * u(rng), robot_T_camera.z() - lm.z_m, 0.2 * u(rng));
 		const CPose3D world_T_camera = lm.world_T_landmark() + landmark_T_camera;
 		const CPose3D world_T_robot3 = world_T_camera + (-robot_T_camera);
 		ASSERT_NEAR(world_T_robot3.z(), 0, 1e-9);
@@ -197,14 +200,15 @@ TEST(Composition, RobotWorldPoseRecoveredExactly)
 		const Measurement m =
 			measure(projectCorners(landmark_T_camera, cam, lm.geometry()), cam, lm.geometry());
 		Eigen::Matrix3d C_world, J;
-		const CPose2D robot = robotPoseInWorld(m.pose_in_landmark, m.C_R,
-			landmarkPlanarPose(lm.world_T_landmark()), cameraPlanarPose(robot_T_camera), &C_world, &J);
+		const CPose2D robot = robotPoseInWorld(
+			m.pose_in_landmark, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+			cameraPlanarPose(robot_T_camera), &C_world, &J);
 		EXPECT_NEAR(robot.x(), world_T_robot3.x(), 1e-8);
 		EXPECT_NEAR(robot.y(), world_T_robot3.y(), 1e-8);
 		EXPECT_NEAR(wrapToPi(robot.phi() - world_T_robot3.yaw()), 0, 1e-9);
 		// The inverse mapping gives back the camera's pose in L.
-		const Eigen::Vector3d c = cameraInLandmark(robot, landmarkPlanarPose(lm.world_T_landmark()),
-			cameraPlanarPose(robot_T_camera));
+		const Eigen::Vector3d c = cameraInLandmark(
+			robot, landmarkPlanarPose(lm.world_T_landmark()), cameraPlanarPose(robot_T_camera));
 		EXPECT_LT((c.head<2>() - m.pose_in_landmark.head<2>()).norm(), 1e-8);
 		EXPECT_NEAR(wrapToPi(c[2] - m.pose_in_landmark[2]), 0, 1e-9);
 
@@ -216,9 +220,11 @@ TEST(Composition, RobotWorldPoseRecoveredExactly)
 			Eigen::Vector3d a = m.pose_in_landmark, b = a;
 			a[k] += h;
 			b[k] -= h;
-			const CPose2D ra = robotPoseInWorld(a, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+			const CPose2D ra = robotPoseInWorld(
+				a, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
 				cameraPlanarPose(robot_T_camera));
-			const CPose2D rb = robotPoseInWorld(b, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+			const CPose2D rb = robotPoseInWorld(
+				b, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
 				cameraPlanarPose(robot_T_camera));
 			Jn.col(k) << (ra.x() - rb.x()) / (2 * h), (ra.y() - rb.y()) / (2 * h),
 				wrapToPi(ra.phi() - rb.phi()) / (2 * h);
@@ -226,7 +232,8 @@ TEST(Composition, RobotWorldPoseRecoveredExactly)
 		EXPECT_LT((J - Jn).norm(), 1e-6 * J.norm());
 		EXPECT_LT((C_world - J * m.C_R * J.transpose()).norm(), 1e-12 * C_world.norm());
 		// A rigid change of frame keeps the determinant of the covariance.
-		EXPECT_NEAR(C_world.determinant(), m.C_R.determinant(), 1e-6 * std::abs(m.C_R.determinant()));
+		EXPECT_NEAR(
+			C_world.determinant(), m.C_R.determinant(), 1e-6 * std::abs(m.C_R.determinant()));
 	}
 }
 
@@ -237,7 +244,8 @@ TEST(Composition, CameraPlanarPoseOfMountedCamera)
 	EXPECT_NEAR(p.x(), 0.3, 1e-12);
 	EXPECT_NEAR(p.y(), -0.1, 1e-12);
 	EXPECT_NEAR(p.phi(), 0.0, 1e-12);
-	const CPose3D left = CPose3D(0, 0, 0.5, M_PI / 2, 0, 0) + CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	const CPose3D left =
+		CPose3D(0, 0, 0.5, M_PI / 2, 0, 0) + CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	EXPECT_NEAR(cameraPlanarPose(left).phi(), M_PI / 2, 1e-12);
 }
 
@@ -327,8 +335,8 @@ TEST(PoseCovariance, SecondOrderMatchesSamples)
 	const Eigen::Vector3d L(3.5, 0.05, 0.3);
 	Eigen::Matrix3d C_L;
 	C_L << 4e-6, 0, 1e-5,  //
-		0, 1e-8, -2e-6,  //
-		1e-5, -2e-6, 9e-4;  // sigma(phi2) = 1.7 deg, phi1 far better known
+		0, 1e-8, -2e-6,	 //
+		1e-5, -2e-6, 9e-4;	// sigma(phi2) = 1.7 deg, phi1 far better known
 	const Eigen::LLT<Eigen::Matrix3d> llt(C_L);
 	std::mt19937 rng(3);
 	std::normal_distribution<double> n01;

@@ -53,7 +53,8 @@ TEST(General, SquarelyFacingLevelCamera180Degrees)
 	// A level camera squarely facing the landmark: yaw exactly 180 deg in L.
 	const CameraModel cam;
 	const LandmarkGeometry g;
-	const cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
+	const cv::Mat K =
+		(cv::Mat_<double>(3, 3) << cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
 	for (const double d : {0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0})
 	{
 		for (const double z : {0.0, 0.25})
@@ -79,7 +80,8 @@ TEST(General, SquarelyFacingLevelCamera180Degrees)
 			std::vector<cv::Point2d> img;
 			for (const auto& c : corners) img.emplace_back(c.x(), c.y());
 			for (const auto& [flag, name] :
-				{std::pair{cv::SOLVEPNP_IPPE_SQUARE, "IPPE_SQUARE"}, std::pair{cv::SOLVEPNP_IPPE, "IPPE"}})
+				 {std::pair{cv::SOLVEPNP_IPPE_SQUARE, "IPPE_SQUARE"},
+				  std::pair{cv::SOLVEPNP_IPPE, "IPPE"}})
 			{
 				std::vector<cv::Mat> rv, tv;
 				const int n = cv::solvePnPGeneric(obj, img, K, cv::Mat(), rv, tv, false, flag);
@@ -104,7 +106,8 @@ TEST(General, SquarelyFacingLevelCamera180Degrees)
 				std::cout << "[ " << name << " ] d=" << d << " z=" << z << ": " << n
 						  << " solution(s), best rotation error " << best_ang * 180 / M_PI
 						  << " deg, best position error " << best_dt << " m\n";
-				RecordProperty(std::string(name) + "_d" + std::to_string(int(d * 10)) + "_z" +
+				RecordProperty(
+					std::string(name) + "_d" + std::to_string(int(d * 10)) + "_z" +
 						std::to_string(int(z * 100)) + "_rot_err_deg",
 					std::to_string(best_ang * 180 / M_PI));
 			}
@@ -114,7 +117,8 @@ TEST(General, SquarelyFacingLevelCamera180Degrees)
 			std::vector<cv::Point3d> obj2;
 			for (const auto& m : modelPoints(g)) obj2.emplace_back(m.x(), m.y(), m.z());
 			std::vector<cv::Mat> rv, tv;
-			const int n = cv::solvePnPGeneric(obj2, img, K, cv::Mat(), rv, tv, false, cv::SOLVEPNP_IPPE);
+			const int n =
+				cv::solvePnPGeneric(obj2, img, K, cv::Mat(), rv, tv, false, cv::SOLVEPNP_IPPE);
 			double best_ang = 1e9, best_dt = 1e9;
 			for (int i = 0; i < n; ++i)
 			{
@@ -149,7 +153,8 @@ TEST(General, AgreesWithClosedFormForLevelCameras)
 		EXPECT_NEAR(mg.L[0], mc.L[0], 1e-6 * mc.L[0]);
 		EXPECT_NEAR(mg.L[1], mc.L[1], 1e-6);
 		EXPECT_NEAR(mg.L[2], mc.L[2], 1e-6);
-		EXPECT_LT((mg.pose_in_landmark.head<2>() - mc.pose_in_landmark.head<2>()).norm(), 1e-6 * mc.L[0]);
+		EXPECT_LT(
+			(mg.pose_in_landmark.head<2>() - mc.pose_in_landmark.head<2>()).norm(), 1e-6 * mc.L[0]);
 		EXPECT_NEAR(wrapToPi(mg.pose_in_landmark[2] - mc.pose_in_landmark[2]), 0, 1e-6);
 		const auto [ang, dt] = poseError(mg.landmark_T_camera, truth);
 		EXPECT_LT(ang, 1e-6);
@@ -174,9 +179,10 @@ TEST(General, TiltedCameraWithLensDistortion)
 		const double dd = d(rng), aa = a(rng), zz = z(rng);
 		// Heading towards the landmark plus an offset, pitched 10 deg down
 		// (MRPT pitch is about the robot's y: positive = nose down), rolled a little.
-		const CPose3D truth =
-			CPose3D(dd * std::cos(aa), dd * std::sin(aa), zz, aa + M_PI + yaw(rng), 10 * M_PI / 180, roll(rng)) +
-			CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		const CPose3D truth = CPose3D(
+								  dd * std::cos(aa), dd * std::sin(aa), zz, aa + M_PI + yaw(rng),
+								  10 * M_PI / 180, roll(rng)) +
+							  CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 		std::array<Eigen::Vector2d, 4> corners;
 		try
 		{
@@ -188,7 +194,8 @@ TEST(General, TiltedCameraWithLensDistortion)
 		}
 		bool inside = true;
 		for (const auto& c : corners)
-			inside = inside && c.x() > 0 && c.y() > 0 && c.x() < cam.width() - 1 && c.y() < cam.height() - 1;
+			inside = inside && c.x() > 0 && c.y() > 0 && c.x() < cam.width() - 1 &&
+					 c.y() < cam.height() - 1;
 		if (!inside) continue;
 		++tested;
 		PoseOptions gen;

@@ -22,7 +22,7 @@ namespace
 {
 struct Stats
 {
-	Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // of the deviation from the noise-free value
+	Eigen::Vector3d mean = Eigen::Vector3d::Zero();	 // of the deviation from the noise-free value
 	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
 };
 
@@ -109,9 +109,8 @@ TEST(MonteCarlo, FirstOrderCovarianceAndMeanOnTheGrid)
 			// plus 5% of the bias for the higher orders (measured: the
 			// residual reaches 3.6 sigma/sqrt(N) at 3 m frontal, where the
 			// bias is 113 sigma/sqrt(N); printed below).
-			const auto fL = [&](const Eigen::Vector4d& P) {
-				return landmarkFromPrimary(P, cam.fx(), g.innerHalf());
-			};
+			const auto fL = [&](const Eigen::Vector4d& P)
+			{ return landmarkFromPrimary(P, cam.fx(), g.innerHalf()); };
 			const auto fR = [&](const Eigen::Vector4d& P) { return poseFromLandmark(fL(P)); };
 			const Eigen::Vector3d bL = secondOrderBias(fL, m0.P, m0.C_P);
 			const Eigen::Vector3d bR = secondOrderBias(fR, m0.P, m0.C_P);
@@ -123,13 +122,17 @@ TEST(MonteCarlo, FirstOrderCovarianceAndMeanOnTheGrid)
 					<< "L[" << k << "] d " << d << " angle " << deg;
 				EXPECT_LT(std::abs(sR.mean[k] - bR[k]), 3 * seR + 0.05 * std::abs(bR[k]))
 					<< "pose[" << k << "] d " << d << " angle " << deg;
-				worst = std::max({worst, std::abs(sL.mean[k] - bL[k]) / seL, std::abs(sR.mean[k] - bR[k]) / seR});
-				worst_raw = std::max({worst_raw, std::abs(sL.mean[k]) / seL, std::abs(sR.mean[k]) / seR});
+				worst = std::max(
+					{worst, std::abs(sL.mean[k] - bL[k]) / seL,
+					 std::abs(sR.mean[k] - bR[k]) / seR});
+				worst_raw =
+					std::max({worst_raw, std::abs(sL.mean[k]) / seL, std::abs(sR.mean[k]) / seR});
 			}
-			std::cout << "[ MC ] d=" << d << " angle=" << deg << " deg: sigma_phi2="
-					  << std::sqrt(m0.C_L(2, 2)) * 180 / M_PI << " deg, sigma_xy="
-					  << std::sqrt(m0.C_R(0, 0) + m0.C_R(1, 1)) * 1000 << " mm, covL err " << eL
-					  << ", covR err " << eR << ", |mean|/(sigma/sqrt N) max " << worst_raw
+			std::cout << "[ MC ] d=" << d << " angle=" << deg
+					  << " deg: sigma_phi2=" << std::sqrt(m0.C_L(2, 2)) * 180 / M_PI
+					  << " deg, sigma_xy=" << std::sqrt(m0.C_R(0, 0) + m0.C_R(1, 1)) * 1000
+					  << " mm, covL err " << eL << ", covR err " << eR
+					  << ", |mean|/(sigma/sqrt N) max " << worst_raw
 					  << ", after the 2nd-order bias " << worst << "\n";
 		}
 	EXPECT_GE(cells, 20);

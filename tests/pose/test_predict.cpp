@@ -37,7 +37,8 @@ MapLandmark wallLandmark(int id = 7, double x = 0, double y = 0, double yaw = 0,
 CPose2D robotFacing(const MapLandmark& lm, double d, double view_angle, double turn = 0)
 {
 	const double a = lm.yaw_rad + view_angle;
-	const CPose2D world_T_camera(lm.x_m + d * std::cos(a), lm.y_m + d * std::sin(a), a + M_PI + turn);
+	const CPose2D world_T_camera(
+		lm.x_m + d * std::cos(a), lm.y_m + d * std::sin(a), a + M_PI + turn);
 	return world_T_camera + (CPose2D() - cameraPlanarPose(kRobotTCamera));
 }
 
@@ -63,8 +64,14 @@ TEST(Predict, VisibleInFrontAndConsistentWithMeasure)
 	EXPECT_LT((m.C_R - p.measurement.C_R).norm(), 1e-12 * m.C_R.norm());
 	// The fix shrinks the prior: posterior <= prior and <= the fix alone.
 	const Eigen::Matrix3d post = p.posterior;
-	EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(kPrior - post).eigenvalues().minCoeff(), -1e-15);
-	EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(p.C_fix_world - post).eigenvalues().minCoeff(), -1e-15);
+	EXPECT_GT(
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(kPrior - post).eigenvalues().minCoeff(),
+		-1e-15);
+	EXPECT_GT(
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(p.C_fix_world - post)
+			.eigenvalues()
+			.minCoeff(),
+		-1e-15);
 	EXPECT_NEAR(p.score, post(0, 0) + post(1, 1), 1e-18);
 }
 
@@ -87,7 +94,8 @@ TEST(Predict, VisibilityFlagsOnCraftedCases)
 	// Too small: 6 m away the 160 mm square is 21 px tall (< 30 px).
 	VisibilityOptions vis;
 	vis.max_range_m = 10;
-	p = predictSighting(robotFacing(lm, 6.0, 0.0), kPrior, kRobotTCamera, cam, lm, PoseOptions(), vis);
+	p = predictSighting(
+		robotFacing(lm, 6.0, 0.0), kPrior, kRobotTCamera, cam, lm, PoseOptions(), vis);
 	EXPECT_TRUE(p.in_fov);
 	EXPECT_TRUE(p.in_range);
 	EXPECT_FALSE(p.big_enough);
@@ -95,7 +103,8 @@ TEST(Predict, VisibilityFlagsOnCraftedCases)
 	EXPECT_FALSE(p.visible());
 	// ... but a scale-2 landmark at the same place is big enough.
 	const MapLandmark big = wallLandmark(8, 0, 0, 0, 2.0);
-	p = predictSighting(robotFacing(big, 6.0, 0.0), kPrior, kRobotTCamera, cam, big, PoseOptions(), vis);
+	p = predictSighting(
+		robotFacing(big, 6.0, 0.0), kPrior, kRobotTCamera, cam, big, PoseOptions(), vis);
 	EXPECT_TRUE(p.visible());
 	// Out of range with the default 6 m limit.
 	p = predictSighting(robotFacing(big, 6.5, 0.0), kPrior, kRobotTCamera, cam, big);
@@ -121,9 +130,9 @@ TEST(Predict, RankingPrefersTheInformativeLandmark)
 	// Robot at the origin looking along +x; landmarks on a wall at x = 2..4
 	// facing -x, and one behind the robot.
 	LandmarkMap map;
-	map.landmarks.push_back(wallLandmark(1, 4.0, 0.10, M_PI));  // far
-	map.landmarks.push_back(wallLandmark(2, 1.6, -0.15, M_PI));  // near: best
-	map.landmarks.push_back(wallLandmark(3, 2.5, 0.20, M_PI));  // middle
+	map.landmarks.push_back(wallLandmark(1, 4.0, 0.10, M_PI));	// far
+	map.landmarks.push_back(wallLandmark(2, 1.6, -0.15, M_PI));	 // near: best
+	map.landmarks.push_back(wallLandmark(3, 2.5, 0.20, M_PI));	// middle
 	map.landmarks.push_back(wallLandmark(4, -2.0, 0.0, 0.0));  // behind the robot
 	map.landmarks.push_back(wallLandmark(5, 2.0, 0.0, 0.0));  // back side towards the robot
 	const CPose2D robot(0, 0, 0);

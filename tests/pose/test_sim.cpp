@@ -18,7 +18,7 @@ TEST(PoseOnRenders, TruthCornersGiveLAndPose)
 	lm.x_m = 3.0;
 	lm.y_m = 1.0;
 	lm.z_m = 0.6;
-	lm.yaw_rad = M_PI;  // facing -x
+	lm.yaw_rad = M_PI;	// facing -x
 	scene.map.landmarks.push_back(lm);
 	scene.camera = CameraModel();
 	const sim::RenderOptions ro;
@@ -53,8 +53,9 @@ TEST(PoseOnRenders, TruthCornersGiveLAndPose)
 						wrapToPi(m.pose_in_landmark[2] - t.sighting.pose_in_landmark[2]), 0, 1e-6);
 					EXPECT_LT((m.P - t.P).norm(), 1e-6);
 					// And the robot (here: the camera) in the world.
-					const auto w = robotPoseInWorld(m.pose_in_landmark, m.C_R,
-						landmarkPlanarPose(lm.world_T_landmark()), mrpt::poses::CPose2D());
+					const auto w = robotPoseInWorld(
+						m.pose_in_landmark, m.C_R, landmarkPlanarPose(lm.world_T_landmark()),
+						mrpt::poses::CPose2D());
 					const mrpt::poses::CPose2D truth_w = cameraPlanarPose(scene.world_T_camera);
 					EXPECT_NEAR(w.x(), truth_w.x(), 1e-6 * d);
 					EXPECT_NEAR(w.y(), truth_w.y(), 1e-6 * d);

@@ -53,8 +53,11 @@ TEST(Uncertainty, SizeForMeetsTheRequestMinimally)
 			EXPECT_LE(k * s.at.sigma_heading_rad, acc_rad * (1 + 1e-6));
 			EXPECT_GE(s.at.size_px, 30 * (1 - 1e-6));
 			// 1% smaller fails one of the requirements.
-			const auto u = predictUncertainty(cam, LandmarkGeometry::scaled(0.99 * s.scale), 0.05, d, a);
-			EXPECT_TRUE(k * u.sigma_position_m > acc_m || k * u.sigma_heading_rad > acc_rad || u.size_px < 30)
+			const auto u =
+				predictUncertainty(cam, LandmarkGeometry::scaled(0.99 * s.scale), 0.05, d, a);
+			EXPECT_TRUE(
+				k * u.sigma_position_m > acc_m || k * u.sigma_heading_rad > acc_rad ||
+				u.size_px < 30)
 				<< "d " << d << " a " << a;
 			EXPECT_FALSE(describeSizeAdvice(s, k).empty());
 		}
@@ -70,7 +73,7 @@ TEST(Uncertainty, TableAndFigure)
 	const CameraModel cam;
 	const std::string t = accuracyTable(cam, 1.0, 0.05, 0.0, {0.5, 1.0, 4.5});
 	EXPECT_NE(t.find("yes"), std::string::npos);
-	EXPECT_NE(t.find("too small"), std::string::npos);  // 4.5 m: 28 px
+	EXPECT_NE(t.find("too small"), std::string::npos);	// 4.5 m: 28 px
 	const std::string path =
 		(std::filesystem::temp_directory_path() / "codemark_test_fig3.png").string();
 	FigureOptions fo;

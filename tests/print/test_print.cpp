@@ -40,7 +40,7 @@ struct TempDir
 	explicit TempDir(const std::string& name)
 	{
 		path = fs::temp_directory_path() /
-			("codemark-test-print-" + name + "-" + std::to_string(::getpid()));
+			   ("codemark-test-print-" + name + "-" + std::to_string(::getpid()));
 		fs::remove_all(path);
 	}
 	~TempDir()
@@ -59,7 +59,8 @@ std::string readFile(const fs::path& p)
 	return s.str();
 }
 
-PrintOptions options(const std::vector<int>& ids, const std::string& dir, const std::string& formats)
+PrintOptions options(
+	const std::vector<int>& ids, const std::string& dir, const std::string& formats)
 {
 	PrintOptions o;
 	o.ids = ids;
@@ -79,8 +80,8 @@ struct PngChunk
 std::uint32_t be32(const std::string& s, std::size_t at)
 {
 	const auto* p = reinterpret_cast<const unsigned char*>(s.data() + at);
-	return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) |
-		(std::uint32_t(p[2]) << 8) | std::uint32_t(p[3]);
+	return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) |
+		   std::uint32_t(p[3]);
 }
 
 std::vector<PngChunk> pngChunks(const std::string& png)
@@ -145,10 +146,12 @@ double mmAttribute(const Attributes& a, const std::string& key)
 std::vector<std::array<double, 4>> pdfMediaBoxes(const std::string& pdf)
 {
 	std::vector<std::array<double, 4>> out;
-	const std::regex box(R"(/MediaBox\s*\[\s*([-0-9.]+)\s+([-0-9.]+)\s+([-0-9.]+)\s+([-0-9.]+)\s*\])");
-	for (auto it = std::sregex_iterator(pdf.begin(), pdf.end(), box); it != std::sregex_iterator(); ++it)
-		out.push_back({std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]),
-					   std::stod((*it)[4])});
+	const std::regex box(
+		R"(/MediaBox\s*\[\s*([-0-9.]+)\s+([-0-9.]+)\s+([-0-9.]+)\s+([-0-9.]+)\s*\])");
+	for (auto it = std::sregex_iterator(pdf.begin(), pdf.end(), box); it != std::sregex_iterator();
+		 ++it)
+		out.push_back(
+			{std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]), std::stod((*it)[4])});
 	return out;
 }
 
@@ -173,14 +176,16 @@ bool isWhite(const cv::Vec3d& bgr) { return bgr[0] > 215 && bgr[1] > 215 && bgr[
 // (frame_x_mm, frame_y_mm), sizes in mm of the spec times \a scale, by
 // sampling the nine cell centres; -1 when a cell is neither black nor green
 // or the centre is green.
-int decodeAt(const cv::Mat& img, double px_per_mm, double frame_x_mm, double frame_y_mm, double scale)
+int decodeAt(
+	const cv::Mat& img, double px_per_mm, double frame_x_mm, double frame_y_mm, double scale)
 {
 	CodeCells cells{};
 	const double cx = frame_x_mm + 100 * scale, cy = frame_y_mm + 100 * scale;
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)
 		{
-			const cv::Vec3d m = meanAt(img, px_per_mm, cx + (c - 1) * 30 * scale, cy + (r - 1) * 30 * scale);
+			const cv::Vec3d m =
+				meanAt(img, px_per_mm, cx + (c - 1) * 30 * scale, cy + (r - 1) * 30 * scale);
 			if (!isBlack(m) && !isGreen(m)) return -1;
 			cells[r][c] = isBlack(m);
 		}
@@ -196,13 +201,13 @@ std::vector<double> transitionsAlongRow(const cv::Mat& img, double px_per_mm, do
 	auto cls = [&](int u)
 	{
 		const cv::Vec3b p = img.at<cv::Vec3b>(v, u);
-		if (p[1] > 128 && p[2] > 128) return 0;  // white
+		if (p[1] > 128 && p[2] > 128) return 0;	 // white
 		if (p[1] > 128) return 2;  // green
 		return 1;  // black
 	};
 	std::vector<double> out;
 	for (int u = 1; u < img.cols; ++u)
-		if (cls(u) != cls(u - 1)) out.push_back(u / px_per_mm);  // edge between u-1 and u
+		if (cls(u) != cls(u - 1)) out.push_back(u / px_per_mm);	 // edge between u-1 and u
 	return out;
 }
 }  // namespace
@@ -234,7 +239,7 @@ TEST(PrintPng, ReadBackDecodesTheIdAndMeasuresTheFrame)
 		// Along the row through the centre (the centre cell is black):
 		// white | black frame | green | black centre cell | green | black frame | white.
 		const auto t = transitionsAlongRow(img, ppmm, fy + 100);
-		const double tol = 1.0 / ppmm;  // one pixel
+		const double tol = 1.0 / ppmm;	// one pixel
 		ASSERT_GE(t.size(), 6u) << "id " << id;
 		EXPECT_NEAR(t.front(), fx, tol);
 		EXPECT_NEAR(t.back() - t.front(), 200.0, tol) << "outer frame [mm]";
@@ -302,8 +307,8 @@ TEST(PrintPng, LabelStaysInsideItsBox)
 		const Placement p = appendLandmark(page, g, 255, 30, 10);
 		const double dpi = 300, ppmm = dpi / kMmPerInch;
 		const std::string png = pngBytes(page, dpi);
-		const cv::Mat img = cv::imdecode(
-			std::vector<unsigned char>(png.begin(), png.end()), cv::IMREAD_GRAYSCALE);
+		const cv::Mat img =
+			cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()), cv::IMREAD_GRAYSCALE);
 		ASSERT_FALSE(img.empty());
 		const double below_margin_mm = p.frame_y_mm + 200 * scale + 5 * scale;
 		const int top = static_cast<int>(std::ceil(below_margin_mm * ppmm));
@@ -316,7 +321,8 @@ TEST(PrintPng, LabelStaysInsideItsBox)
 		EXPECT_LE((top + box.y + box.height) / ppmm, p.ink_y_mm + p.ink_h_mm) << "scale " << scale;
 		// Nothing but the label between the frame's margin and the label.
 		std::vector<cv::Point> in_margin;
-		const int frame_bottom = static_cast<int>(std::ceil((p.frame_y_mm + 200 * scale) * ppmm)) + 1;
+		const int frame_bottom =
+			static_cast<int>(std::ceil((p.frame_y_mm + 200 * scale) * ppmm)) + 1;
 		cv::findNonZero(img.rowRange(frame_bottom, top) < 250, in_margin);
 		EXPECT_TRUE(in_margin.empty()) << "ink in the quiet margin at scale " << scale;
 	}
@@ -363,7 +369,8 @@ TEST(PrintPng, PhysChunkStates600Dpi)
 			EXPECT_TRUE(c.crc_ok);
 		}
 	EXPECT_EQ(count, 1);
-	EXPECT_THROW(withPngResolution("not a png at all, but long enough to look", 600), std::invalid_argument);
+	EXPECT_THROW(
+		withPngResolution("not a png at all, but long enough to look", 600), std::invalid_argument);
 }
 
 // (c) The SVG is in millimetres: root width/height in mm equal to the viewBox,
@@ -412,7 +419,8 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 		// The black cells of ID 200 = 0b11001000 (spec bit order: bits 7, 6, 3
 		// are r0c0, r0c1, r1c2) plus the centre, each 30 mm, at the right
 		// place; an asymmetric ID, so a transposed board fails.
-		const bool expected[3][3] = {{true, true, false}, {false, true, true}, {false, false, false}};
+		const bool expected[3][3] = {
+			{true, true, false}, {false, true, true}, {false, false, false}};
 		const CodeCells cells = encodeId(200);
 		int black = 0;
 		for (int r = 0; r < 3; ++r)
@@ -433,10 +441,15 @@ TEST(PrintSvg, FrameAndReferenceSquareMeasureTheSpecTimesScale)
 		// The label, below the frame and outside the quiet margin.
 		const auto texts = svgElements(svg, "text");
 		ASSERT_EQ(texts.size(), 1u);
-		EXPECT_GT(std::stod(texts[0].at("y")) - std::stod(texts[0].at("font-size")) * 0.8,
-				  oy + 205 * scale);
-		EXPECT_NE(svg.find("codemark ID 200 (scale " + std::string(scale == 1.0 ? "1.0" : "1.5")), std::string::npos);
-		EXPECT_NE(svg.find(scale == 1.0 ? "reference square 160 mm" : "reference square 240 mm"), std::string::npos);
+		EXPECT_GT(
+			std::stod(texts[0].at("y")) - std::stod(texts[0].at("font-size")) * 0.8,
+			oy + 205 * scale);
+		EXPECT_NE(
+			svg.find("codemark ID 200 (scale " + std::string(scale == 1.0 ? "1.0" : "1.5")),
+			std::string::npos);
+		EXPECT_NE(
+			svg.find(scale == 1.0 ? "reference square 160 mm" : "reference square 240 mm"),
+			std::string::npos);
 	}
 }
 
@@ -498,7 +511,7 @@ TEST(PrintRun, RejectsBadOptionsWithOneClearLine)
 	expectInvalid(o, "dpi must be in 10..1200");
 	o.dpi = 600;
 	o.sheet = true;
-	o.scale = 1.1;  // a 220 mm frame on a 210 mm page
+	o.scale = 1.1;	// a 220 mm frame on a 210 mm page
 	expectInvalid(o, "does not fit on A4");
 	o.scale = 1.0;
 	o.paper_border_mm = 5.5;  // 200 + 2 x 5.5 > 210
@@ -600,7 +613,7 @@ TEST(PrintSheet, HalfScaleSheetHoldsSeveralDisjointLandmarks)
 		ASSERT_EQ(placed.size(), pages.size());
 		EXPECT_EQ(static_cast<int>(placed[0].size()), per_page);
 		std::size_t total = 0;
-		const double frame = 100, margin = 2.5;  // scale 0.5
+		const double frame = 100, margin = 2.5;	 // scale 0.5
 		const double edge = std::max(margin, border) - 1e-9;
 		for (const auto& page_placements : placed)
 		{
@@ -625,7 +638,8 @@ TEST(PrintSheet, HalfScaleSheetHoldsSeveralDisjointLandmarks)
 					// No ink of b inside a's frame grown by its quiet margin.
 					const double x0 = a.frame_x_mm - margin, x1 = a.frame_x_mm + frame + margin;
 					const double y0 = a.frame_y_mm - margin, y1 = a.frame_y_mm + frame + margin;
-					const bool apart = b.ink_x_mm >= x1 - 1e-9 || b.ink_x_mm + b.ink_w_mm <= x0 + 1e-9 ||
+					const bool apart =
+						b.ink_x_mm >= x1 - 1e-9 || b.ink_x_mm + b.ink_w_mm <= x0 + 1e-9 ||
 						b.ink_y_mm >= y1 - 1e-9 || b.ink_y_mm + b.ink_h_mm <= y0 + 1e-9;
 					EXPECT_TRUE(apart) << b.id << " intrudes on " << a.id << "'s quiet margin";
 				}
@@ -684,7 +698,8 @@ TEST(PrintApp, HelpAndErrorsThroughTheCommandLine)
 	};
 	EXPECT_EQ(runApp("--help"), 0);
 	const std::string help = readFile(out);
-	for (const char* opt : {"--id", "--out", "--format", "--scale", "--sheet", "--dpi", "--landmark"})
+	for (const char* opt :
+		 {"--id", "--out", "--format", "--scale", "--sheet", "--dpi", "--landmark"})
 		EXPECT_NE(help.find(opt), std::string::npos) << opt;
 
 	const std::string o = "--out '" + (dir.path / "o").string() + "'";

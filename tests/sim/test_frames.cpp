@@ -74,13 +74,17 @@ TEST(Frames, BodyAndOpticalFrames)
 
 TEST(Frames, CameraPosesFile)
 {
-	const auto poses = loadCameraPoses(writeTemp("poses_ok.txt", "# x y z yaw pitch roll\n1 2 0.6 90 0 0\n\n3 4 0.5 -45 0 0 # c\n"));
+	const auto poses = loadCameraPoses(writeTemp(
+		"poses_ok.txt", "# x y z yaw pitch roll\n1 2 0.6 90 0 0\n\n3 4 0.5 -45 0 0 # c\n"));
 	ASSERT_EQ(poses.size(), 2u);
 	const auto body = bodyFromOptical(poses[0]);
 	EXPECT_NEAR(body.x(), 1, 1e-12);
 	EXPECT_NEAR(body.yaw(), M_PI / 2, 1e-12);
 	const std::pair<const char*, const char*> bad[] = {
-		{"1 2 3 4 5\n", ":1:"}, {"1 2 3 4 5 6\n1 2 x 4 5 6\n", ":2:"}, {"1 2 3 nan 5 6\n", ":1:"}, {"# empty\n", "no camera poses"}};
+		{"1 2 3 4 5\n", ":1:"},
+		{"1 2 3 4 5 6\n1 2 x 4 5 6\n", ":2:"},
+		{"1 2 3 nan 5 6\n", ":1:"},
+		{"# empty\n", "no camera poses"}};
 	for (const auto& [text, expect] : bad)
 	{
 		try
@@ -106,11 +110,12 @@ TEST(Frames, TruthJsonListsTheLandmarksInView)
 	const std::string j = frameTruthJson("a \"b\".png", scene.world_T_camera, truth, scene.camera);
 	EXPECT_EQ(j.find("{\"image\": \"a \\\"b\\\".png\""), 0u) << j;
 	EXPECT_NE(j.find("\"id\": 17"), std::string::npos);
-	EXPECT_EQ(j.find("\"id\": 37"), std::string::npos);  // behind the camera
+	EXPECT_EQ(j.find("\"id\": 37"), std::string::npos);	 // behind the camera
 	int in_view = 0;
 	for (const auto& t : truth) in_view += isInView(t, scene.camera);
 	size_t n = 0;
-	for (size_t p = j.find("\"corners\""); p != std::string::npos; p = j.find("\"corners\"", p + 1)) ++n;
+	for (size_t p = j.find("\"corners\""); p != std::string::npos; p = j.find("\"corners\"", p + 1))
+		++n;
 	EXPECT_EQ(int(n), in_view);
 	EXPECT_EQ(std::count(j.begin(), j.end(), '{'), std::count(j.begin(), j.end(), '}'));
 	EXPECT_EQ(std::count(j.begin(), j.end(), '['), std::count(j.begin(), j.end(), ']'));

@@ -31,7 +31,8 @@ MapLandmark makeLandmark(int id = 37, double scale = 1.0)
 	return lm;
 }
 
-Scene makeScene(const MapLandmark& lm, const CPose3D& world_T_camera, const CameraModel& cam = CameraModel())
+Scene makeScene(
+	const MapLandmark& lm, const CPose3D& world_T_camera, const CameraModel& cam = CameraModel())
 {
 	Scene s;
 	s.map.landmarks.push_back(lm);
@@ -116,7 +117,8 @@ std::vector<double> rowEdgeErrors(
 		const bool p1_first = perp1.yAt(0.5 * (l + r)) < perp2.yAt(0.5 * (l + r));
 		const Line& upper = p1_first ? perp1 : perp2;
 		const Line& lower = p1_first ? perp2 : perp1;
-		if (!(v - 1.0 > std::max(upper.yAt(l), upper.yAt(r)) && v + 1.0 < std::min(lower.yAt(l), lower.yAt(r))))
+		if (!(v - 1.0 > std::max(upper.yAt(l), upper.yAt(r)) &&
+			  v + 1.0 < std::min(lower.yAt(l), lower.yAt(r))))
 			continue;
 		double sum = 0;
 		for (int u = ua; u <= ub; ++u) sum += g.at<double>(v, u);
@@ -147,11 +149,13 @@ std::array<std::vector<double>, 4> innerEdgeErrors(
 	const Line board_bottom{facePixel(tr, cam, -b, -b), facePixel(tr, cam, b, -b)};
 	cv::Mat gt;
 	cv::transpose(g, gt);
-	return {rowEdgeErrors(g, left, board_left, top, bottom, true),
-			rowEdgeErrors(g, right, board_right, top, bottom, false),
-			rowEdgeErrors(gt, top.swapped(), board_top.swapped(), left.swapped(), right.swapped(), true),
-			rowEdgeErrors(
-				gt, bottom.swapped(), board_bottom.swapped(), left.swapped(), right.swapped(), false)};
+	return {
+		rowEdgeErrors(g, left, board_left, top, bottom, true),
+		rowEdgeErrors(g, right, board_right, top, bottom, false),
+		rowEdgeErrors(
+			gt, top.swapped(), board_top.swapped(), left.swapped(), right.swapped(), true),
+		rowEdgeErrors(
+			gt, bottom.swapped(), board_bottom.swapped(), left.swapped(), right.swapped(), false)};
 }
 }  // namespace
 
@@ -196,7 +200,8 @@ TEST(Render, EdgesWithinTwoHundredthsOfAPixel)
 			// Alternate a roll about the optical axis so edges are slanted
 			// in the image, not only vertical.
 			const double roll = (configs % 2) ? 0.15 : 0.0;
-			const CPose3D pose = levelCameraLookingAt(lm, d, a, 0.05 * d, 0.03) + CPose3D(0, 0, 0, roll, 0, 0);
+			const CPose3D pose =
+				levelCameraLookingAt(lm, d, a, 0.05 * d, 0.03) + CPose3D(0, 0, 0, roll, 0, 0);
 			const Scene scene = makeScene(lm, pose, cam);
 			const Render r = render(scene, o, 1);
 			const LandmarkTruth& tr = r.truth[0];
@@ -205,7 +210,8 @@ TEST(Render, EdgesWithinTwoHundredthsOfAPixel)
 			for (const auto& c : tr.corners_px)
 				ASSERT_TRUE(c.x() > 4 && c.x() < 635 && c.y() > 4 && c.y() < 475)
 					<< "d " << d << " a " << a_deg << " corner " << c.transpose();
-			const auto errs = innerEdgeErrors(greenFraction(r.image), tr, cam, lm.geometry().cell_size_m);
+			const auto errs =
+				innerEdgeErrors(greenFraction(r.image), tr, cam, lm.geometry().cell_size_m);
 			const char* names[] = {"left", "right", "top", "bottom"};
 			for (int e = 0; e < 4; ++e)
 			{
@@ -227,7 +233,7 @@ TEST(Render, CodeCellsWhereEncodeIdSays)
 			const MapLandmark lm = makeLandmark(id);
 			RenderOptions o;
 			o.background = bg;
-			o.distractors = 40;  // drawn under the landmark, never over it
+			o.distractors = 40;	 // drawn under the landmark, never over it
 			const Scene scene = makeScene(lm, levelCameraLookingAt(lm, 1.2, 25 * kDeg, 0.1, -0.05));
 			const Render r = render(scene, o, 7 + id);
 			const LandmarkGeometry g = lm.geometry();
@@ -237,8 +243,10 @@ TEST(Render, CodeCellsWhereEncodeIdSays)
 				{
 					const Eigen::Vector2d f = g.cellCentreFace(row, col);
 					const Eigen::Vector2d px = facePixel(r.truth[0], scene.camera, f.x(), f.y());
-					const cv::Vec3b v = r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
-					EXPECT_TRUE(v[1] < 60 || v[1] > 200) << "cell " << row << col << " G " << int(v[1]);
+					const cv::Vec3b v =
+						r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
+					EXPECT_TRUE(v[1] < 60 || v[1] > 200)
+						<< "cell " << row << col << " G " << int(v[1]);
 					seen[row][col] = v[1] < 128;
 				}
 			EXPECT_EQ(seen, encodeId(id)) << "id " << id;
@@ -287,8 +295,9 @@ TEST(Render, TruthMatchesTheScene)
 				EXPECT_NEAR(tr.sighting.L[2], a - bearing, 1e-9);
 				EXPECT_NEAR(tr.sighting.pose_in_landmark[0], d * std::cos(a), 1e-9);
 				EXPECT_NEAR(tr.sighting.pose_in_landmark[1], d * std::sin(a), 1e-9);
-				EXPECT_NEAR(std::atan2(tr.sighting.pose_in_landmark[1], tr.sighting.pose_in_landmark[0]),
-							tr.sighting.L[1] + tr.sighting.L[2], 1e-9);
+				EXPECT_NEAR(
+					std::atan2(tr.sighting.pose_in_landmark[1], tr.sighting.pose_in_landmark[0]),
+					tr.sighting.L[1] + tr.sighting.L[2], 1e-9);
 				EXPECT_NEAR(tr.landmark_T_camera.z(), height, 1e-9);
 				// Corners: the camera model on the reference points.
 				const auto ref = lm.geometry().referencePoints();
@@ -333,21 +342,25 @@ TEST(Render, DistortedCornersWhereTheCameraProjects)
 	for (double d : {0.9, 1.6})
 	{
 		// Off-centre, where the distortion bends the edges most.
-		const Scene scene = makeScene(lm, levelCameraLookingAt(lm, d, 30 * kDeg, 0.12 * d, 0.2), cam);
+		const Scene scene =
+			makeScene(lm, levelCameraLookingAt(lm, d, 30 * kDeg, 0.12 * d, 0.2), cam);
 		const Render r = render(scene, edgeOptions(), 3);
 		const LandmarkTruth& tr = r.truth[0];
 		ASSERT_TRUE(tr.fully_visible) << "d " << d << " corner " << tr.corners_px[0].transpose();
 		const cv::Mat gf = greenFraction(r.image);
 		// The true (curved) image of a face segment at image row v, by
 		// bisection on the segment (v is monotonic along it).
-		const auto curveX = [&](double s, double t0, double t1, double v) {
+		const auto curveX = [&](double s, double t0, double t1, double v)
+		{
 			double lo = t0, hi = t1;
 			const bool up = facePixel(tr, cam, s, lo).y() < facePixel(tr, cam, s, hi).y();
 			for (int i = 0; i < 60; ++i)
 			{
 				const double mid = 0.5 * (lo + hi);
-				if ((facePixel(tr, cam, s, mid).y() < v) == up) lo = mid;
-				else hi = mid;
+				if ((facePixel(tr, cam, s, mid).y() < v) == up)
+					lo = mid;
+				else
+					hi = mid;
 			}
 			return facePixel(tr, cam, s, 0.5 * (lo + hi)).x();
 		};
@@ -355,8 +368,10 @@ TEST(Render, DistortedCornersWhereTheCameraProjects)
 		int rows = 0;
 		for (int side : {-1, +1})  // left edge (green to its right), right edge
 		{
-			const double top_v = std::max(tr.corners_px[side < 0 ? 0 : 1].y(), tr.corners_px[side < 0 ? 1 : 0].y());
-			const double bot_v = std::min(tr.corners_px[side < 0 ? 3 : 2].y(), tr.corners_px[side < 0 ? 2 : 3].y());
+			const double top_v =
+				std::max(tr.corners_px[side < 0 ? 0 : 1].y(), tr.corners_px[side < 0 ? 1 : 0].y());
+			const double bot_v =
+				std::min(tr.corners_px[side < 0 ? 3 : 2].y(), tr.corners_px[side < 0 ? 2 : 3].y());
 			for (int v = int(std::ceil(top_v + 3)); v <= int(std::floor(bot_v - 3)); ++v)
 			{
 				const double e = curveX(side * h, h, -h, v), xb = curveX(side * b, h, -h, v);
@@ -376,7 +391,8 @@ TEST(Render, DistortedCornersWhereTheCameraProjects)
 				double sum = 0;
 				for (int u = ua; u <= ub; ++u) sum += gf.at<double>(v, u);
 				const double measured = side < 0 ? ub + 0.5 - sum : ua - 0.5 + sum;
-				EXPECT_LT(std::abs(measured - e), 0.1) << "d " << d << " side " << side << " row " << v;
+				EXPECT_LT(std::abs(measured - e), 0.1)
+					<< "d " << d << " side " << side << " row " << v;
 				worst = std::max(worst, std::abs(measured - e));
 				++rows;
 			}
@@ -431,7 +447,9 @@ TEST(Render, BehindTheCameraDrawsNothing)
 	EXPECT_FALSE(tr.in_front);
 	EXPECT_FALSE(tr.fully_visible);
 	EXPECT_TRUE(std::isnan(tr.corners_px[0].x()));
-	EXPECT_EQ(cv::norm(r.image, cv::Mat(r.image.size(), CV_8UC3, cv::Scalar::all(128)), cv::NORM_INF), 0.0);
+	EXPECT_EQ(
+		cv::norm(r.image, cv::Mat(r.image.size(), CV_8UC3, cv::Scalar::all(128)), cv::NORM_INF),
+		0.0);
 	// Half behind the camera (the camera inside the landmark's plane
 	// region, looking along it): clipped at the near plane, no crash.
 	const Scene grazing = makeScene(lm, levelCameraLookingAt(lm, 0.05, 80 * kDeg, 0.0, -1.3));
@@ -450,7 +468,9 @@ TEST(Render, CameraBehindTheLandmarkIsNotFacing)
 	EXPECT_FALSE(tr.facing);
 	EXPECT_FALSE(tr.fully_visible);
 	EXPECT_LT(tr.sighting.pose_in_landmark[0], 0.0);
-	EXPECT_EQ(cv::norm(r.image, cv::Mat(r.image.size(), CV_8UC3, cv::Scalar::all(128)), cv::NORM_INF), 0.0);
+	EXPECT_EQ(
+		cv::norm(r.image, cv::Mat(r.image.size(), CV_8UC3, cv::Scalar::all(128)), cv::NORM_INF),
+		0.0);
 }
 
 TEST(Render, OcclusionHidesTheRequestedFraction)
@@ -471,7 +491,8 @@ TEST(Render, OcclusionHidesTheRequestedFraction)
 			{
 				const double s = -h + (i + 0.5) * 2 * h / 40, t = -h + (j + 0.5) * 2 * h / 40;
 				const Eigen::Vector2d px = facePixel(tr, scene.camera, s, t);
-				const cv::Vec3b v = r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
+				const cv::Vec3b v =
+					r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
 				grey += std::abs(v[0] - 100) < 3 && std::abs(v[1] - 100) < 3;
 				++total;
 			}
@@ -502,7 +523,8 @@ TEST(Render, EffectsChangeTheImageAsAsked)
 	EXPECT_NEAR(sd[0], 4.0, 0.3);
 	EXPECT_NEAR(mean[0], 128.0, 0.5);
 	// Blur (Gaussian or motion) spreads an edge over more pixels.
-	const auto spread = [&](const cv::Mat& img) {
+	const auto spread = [&](const cv::Mat& img)
+	{
 		const LandmarkTruth& tr = base.truth[0];
 		const int v = int(std::lround(0.5 * (tr.corners_px[0].y() + tr.corners_px[3].y())));
 		const int u = int(std::lround(tr.corners_px[0].x()));
@@ -560,7 +582,8 @@ TEST(Render, EdgesWithDefaultColoursOverClutter)
 	for (double d : {0.7, 1.5, 2.0})
 		for (double a_deg : {0.0, 30.0, -45.0})
 		{
-			const Scene scene = makeScene(lm, levelCameraLookingAt(lm, d, a_deg * kDeg, 0.04 * d, -0.05), cam);
+			const Scene scene =
+				makeScene(lm, levelCameraLookingAt(lm, d, a_deg * kDeg, 0.04 * d, -0.05), cam);
 			const Render r = render(scene, o, 9);
 			const auto errs =
 				innerEdgeErrors(greenFraction(r.image), r.truth[0], cam, lm.geometry().cell_size_m);
@@ -582,7 +605,7 @@ TEST(Render, NearerLandmarksCoverFartherOnes)
 	near.y_m = far.y_m + std::sin(far.yaw_rad) * 1.0;
 	near.yaw_rad = far.yaw_rad;
 	Scene scene;
-	scene.map.landmarks = {near, far};  // map order is not drawing order
+	scene.map.landmarks = {near, far};	// map order is not drawing order
 	scene.world_T_camera = levelCameraLookingAt(far, 2.0, 0.0);
 	const Render r = render(scene, RenderOptions(), 1);
 	ASSERT_EQ(r.truth.size(), 2u);
@@ -596,7 +619,8 @@ TEST(Render, NearerLandmarksCoverFartherOnes)
 		{
 			const Eigen::Vector2d f = g.cellCentreFace(row, col);
 			const Eigen::Vector2d px = facePixel(r.truth[0], scene.camera, f.x(), f.y());
-			const cv::Vec3b v = r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
+			const cv::Vec3b v =
+				r.image.at<cv::Vec3b>(int(std::lround(px.y())), int(std::lround(px.x())));
 			EXPECT_EQ(v[1] < 128, row == 1 && col == 1) << "cell " << row << col;
 		}
 }
@@ -625,9 +649,10 @@ TEST(Render, SampledPathAgreesWithExactCoverage)
 	double worst = 0;
 	cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
 	EXPECT_LT(worst, 40.0);
-	const int differ = cv::countNonZero(diff.reshape(1) > 0), big = cv::countNonZero(diff.reshape(1) > 8);
-	std::cout << "sampled vs exact: mean " << cv::mean(diff)[1] << ", worst " << worst << " grey levels, "
-			  << big << " of " << differ << " differing values above 8\n";
+	const int differ = cv::countNonZero(diff.reshape(1) > 0),
+			  big = cv::countNonZero(diff.reshape(1) > 8);
+	std::cout << "sampled vs exact: mean " << cv::mean(diff)[1] << ", worst " << worst
+			  << " grey levels, " << big << " of " << differ << " differing values above 8\n";
 	EXPECT_GT(differ, 0);  // the two paths really differ (the sampled one ran)
 	EXPECT_LT(big, differ / 10);
 }

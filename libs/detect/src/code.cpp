@@ -63,7 +63,8 @@ struct FaceMap
 
 /** Mean G over a square patch of half-size \a r centred on (x, y) in
  * normalised face coordinates, on a 5 x 5 grid; nullopt if outside. */
-std::optional<double> patchMean(const cv::Mat& bgr, const FaceMap& map, double x, double y, double rx, double ry)
+std::optional<double> patchMean(
+	const cv::Mat& bgr, const FaceMap& map, double x, double y, double rx, double ry)
 {
 	double s = 0;
 	for (int i = -2; i <= 2; ++i)
@@ -94,7 +95,8 @@ std::optional<CodeReading> readCode(
 		// Corners and side midpoints of the outer edge (distortion bends it).
 		const double xs[8] = {-1, 0, 1, 1, 1, 0, -1, -1}, ys[8] = {1, 1, 1, 0, -1, -1, -1, 0};
 		const Eigen::Vector2d px = map(outer * xs[k], outer * ys[k]);
-		if (!(px.x() >= lo_u && px.x() <= hi_u && px.y() >= lo_v && px.y() <= hi_v)) return std::nullopt;
+		if (!(px.x() >= lo_u && px.x() <= hi_u && px.y() >= lo_v && px.y() <= hi_v))
+			return std::nullopt;
 	}
 	// References: the black frame, midway between its inner and outer edge,
 	// and the green ring between the code board and the frame, side by
@@ -137,7 +139,8 @@ std::optional<CodeReading> readCode(
 	if (contrast < p.min_contrast) return std::nullopt;
 	if (r.black_g > p.max_black_ratio * r.green_g) return std::nullopt;
 	for (int side = 0; side < 4; ++side)
-		if (black[side] > p.max_side_black_ratio * green[side] || green[side] < r.black_g + 0.5 * contrast)
+		if (black[side] > p.max_side_black_ratio * green[side] ||
+			green[side] < r.black_g + 0.5 * contrast)
 			return std::nullopt;
 	const double thr = 0.5 * (r.green_g + r.black_g);
 	const double cell = geo.cell_size_m / h;

@@ -16,7 +16,9 @@ cv::Point2f pt(const Eigen::Vector2d& p) { return {float(p.x()), float(p.y())}; 
 constexpr int kShift = 4;
 cv::Point fix(const Eigen::Vector2d& p)
 {
-	return {static_cast<int>(std::lround(p.x() * (1 << kShift))), static_cast<int>(std::lround(p.y() * (1 << kShift)))};
+	return {
+		static_cast<int>(std::lround(p.x() * (1 << kShift))),
+		static_cast<int>(std::lround(p.y() * (1 << kShift)))};
 }
 
 void save(const std::string& dir, const std::string& name, const cv::Mat& img)
@@ -43,27 +45,34 @@ void drawDetections(cv::Mat& img, const std::vector<DetectedLandmark>& landmarks
 		for (int k = 0; k < 4; ++k)
 			cv::line(img, fix(c[k]), fix(c[(k + 1) % 4]), {0, 0, 255}, 1, cv::LINE_AA, kShift);
 		for (int k = 0; k < 4; ++k)
-			cv::circle(img, fix(c[k]), 3 << kShift, k == 0 ? cv::Scalar(255, 0, 255) : cv::Scalar(0, 255, 255), 1,
-				cv::LINE_AA, kShift);
+			cv::circle(
+				img, fix(c[k]), 3 << kShift,
+				k == 0 ? cv::Scalar(255, 0, 255) : cv::Scalar(0, 255, 255), 1, cv::LINE_AA, kShift);
 		// Axes of the landmark at its centre: Y_L (right) in red, Z_L (up) in
 		// blue, half a side long, along the image of the face axes.
 		const Eigen::Vector2d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
 		const Eigen::Vector2d right = 0.25 * ((c[1] - c[0]) + (c[2] - c[3]));
 		const Eigen::Vector2d up = 0.25 * ((c[0] - c[3]) + (c[1] - c[2]));
-		cv::arrowedLine(img, fix(centre), fix(centre + right), {0, 0, 255}, 2, cv::LINE_AA, kShift, 0.2);
-		cv::arrowedLine(img, fix(centre), fix(centre + up), {255, 0, 0}, 2, cv::LINE_AA, kShift, 0.2);
-		cv::putText(img, std::to_string(l.detection.id), pt(c[0] + Eigen::Vector2d(0, -6)),
+		cv::arrowedLine(
+			img, fix(centre), fix(centre + right), {0, 0, 255}, 2, cv::LINE_AA, kShift, 0.2);
+		cv::arrowedLine(
+			img, fix(centre), fix(centre + up), {255, 0, 0}, 2, cv::LINE_AA, kShift, 0.2);
+		cv::putText(
+			img, std::to_string(l.detection.id), pt(c[0] + Eigen::Vector2d(0, -6)),
 			cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 255}, 1, cv::LINE_AA);
 	}
 }
 
 void writeDebugImages(
-	const std::string& dir, const cv::Mat& bgr, const DebugRecord& d, const std::vector<DetectedLandmark>& found)
+	const std::string& dir, const cv::Mat& bgr, const DebugRecord& d,
+	const std::vector<DetectedLandmark>& found)
 {
 	// 1: the colour mask at full size.
 	cv::Mat mask_full;
 	if (!d.mask.empty())
-		cv::resize(d.mask, mask_full, cv::Size(d.mask.cols * d.step, d.mask.rows * d.step), 0, 0, cv::INTER_NEAREST);
+		cv::resize(
+			d.mask, mask_full, cv::Size(d.mask.cols * d.step, d.mask.rows * d.step), 0, 0,
+			cv::INTER_NEAREST);
 	else
 		mask_full = cv::Mat::zeros(bgr.size(), CV_8UC1);
 	save(dir, "1_mask.png", mask_full);
@@ -98,7 +107,8 @@ void writeDebugImages(
 			{
 				const uint8_t p = e.polarity.at<uint8_t>(y, x);
 				if (p)
-					ed(cv::Rect(e.roi.x + x * e.scale, e.roi.y + y * e.scale, e.scale, e.scale)).setTo(colours[p]);
+					ed(cv::Rect(e.roi.x + x * e.scale, e.roi.y + y * e.scale, e.scale, e.scale))
+						.setTo(colours[p]);
 			}
 		cv::rectangle(ed, e.roi, {255, 255, 255});
 	}
@@ -113,8 +123,9 @@ void writeDebugImages(
 		{
 			for (const auto& p : q.sides[k].points)
 				cv::circle(li, fix(p), 1 << (kShift - 1), {0, 255, 255}, -1, cv::LINE_AA, kShift);
-			cv::line(li, fix(q.corners_ideal[k]), fix(q.corners_ideal[(k + 1) % 4]), {0, 0, 255}, 1, cv::LINE_AA,
-				kShift);
+			cv::line(
+				li, fix(q.corners_ideal[k]), fix(q.corners_ideal[(k + 1) % 4]), {0, 0, 255}, 1,
+				cv::LINE_AA, kShift);
 		}
 	}
 	save(dir, "4_lines.png", li);

@@ -12,11 +12,11 @@ namespace codemark::detect
 struct DebugRecord
 {
 	cv::Mat mask;  //!< stage 1-2 output
-	cv::Mat labels;  //!< stage 3 labels
+	cv::Mat labels;	 //!< stage 3 labels
 	int step = 1;
 	std::vector<Candidate> candidates;
 	std::vector<EdgelMap> edgels;  //!< one per examined ROI
-	std::vector<RefinedQuad> quads;  //!< every refined quadrangle, decoded or not
+	std::vector<RefinedQuad> quads;	 //!< every refined quadrangle, decoded or not
 };
 
 /** Writes 1_mask.png, 2_components.png, 3_edgels.png, 4_lines.png and

@@ -37,7 +37,8 @@ DetectionResult detect(
 {
 	DetectionResult res;
 	if (bgr.empty()) return res;
-	if (bgr.type() != CV_8UC3) throw std::invalid_argument("detect: expected a CV_8UC3 (BGR) image");
+	if (bgr.type() != CV_8UC3)
+		throw std::invalid_argument("detect: expected a CV_8UC3 (BGR) image");
 	const bool debug = !debug_dir.empty();
 	DebugRecord dbg;
 	const auto t_start = Clock::now();
@@ -50,9 +51,9 @@ DetectionResult detect(
 
 	// 3. N4-connected components, cardinality and compactness: ROIs.
 	cv::Mat labels;
-	const auto candidates =
-		findCandidates(mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
-			&res.counts.components, geometry.cell_size_m / geometry.inner_size_m);
+	const auto candidates = findCandidates(
+		mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
+		&res.counts.components, geometry.cell_size_m / geometry.inner_size_m);
 	res.counts.rois = static_cast<int>(candidates.size());
 	tm.components_us = microsSince(t);
 
@@ -64,7 +65,8 @@ DetectionResult detect(
 		tm.edgels_us += microsSince(t);
 
 		// 5. Segment selection: size, polarity, slimness, relative length.
-		const auto sides = selectSegments(edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr);
+		const auto sides = selectSegments(
+			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr);
 		tm.segments_us += microsSince(t);
 		if (debug) dbg.edgels.push_back(std::move(edgels));
 		if (!sides) continue;
@@ -76,7 +78,8 @@ DetectionResult detect(
 		++res.counts.quads;
 
 		// 7. Sub-pixel edges, a line per side, corners.
-		const double frame_ratio = (geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
+		const double frame_ratio =
+			(geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
 		auto refined = refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel);
 		tm.subpixel_us += microsSince(t);
 		if (!refined) continue;
@@ -100,7 +103,7 @@ DetectionResult detect(
 			// A line fitted to n evenly spread points is 2 sigma / sqrt(n)
 			// uncertain at its ends.
 			var_end += 4 * refined->sides[k].rms_px * refined->sides[k].rms_px /
-				std::max(1, refined->sides[k].support);
+					   std::max(1, refined->sides[k].support);
 		}
 		qual.corner_sigma_px = std::sqrt(var_end / 4);
 		qual.code_margin = code->margin;
@@ -117,13 +120,14 @@ DetectionResult detect(
 			if (meanCornerDistance(d.detection.corners, other.detection.corners) < 2.0)
 			{
 				duplicate = true;
-				if (d.detection.quality.code_margin > other.detection.quality.code_margin) other = d;
+				if (d.detection.quality.code_margin > other.detection.quality.code_margin)
+					other = d;
 			}
 		if (!duplicate) res.landmarks.push_back(d);
 	}
-	std::sort(res.landmarks.begin(), res.landmarks.end(), [](const auto& a, const auto& b) {
-		return a.detection.id < b.detection.id;
-	});
+	std::sort(
+		res.landmarks.begin(), res.landmarks.end(),
+		[](const auto& a, const auto& b) { return a.detection.id < b.detection.id; });
 	res.counts.decoded = static_cast<int>(res.landmarks.size());
 	tm.total_us = std::chrono::duration<double, std::micro>(Clock::now() - t_start).count();
 

@@ -15,7 +15,8 @@ double gradientThreshold(double fill_g, const EdgelParams& p)
 	return std::max(p.min_gradient, p.rel_gradient * fill_g);
 }
 
-EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold, const EdgelParams& p)
+EdgelMap findEdgels(
+	const cv::Mat& bgr, const cv::Rect& roi_in, double threshold, const EdgelParams& p)
 {
 	EdgelMap m;
 	m.roi = roi_in & cv::Rect(0, 0, bgr.cols, bgr.rows);
@@ -23,7 +24,8 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 	// Large ROIs (near landmarks) are reduced by an integer factor: this
 	// stage only finds the sides to about a pixel, the sub-pixel stage works
 	// at full resolution, and the cost stays bounded.
-	const int k = std::max(1, static_cast<int>(std::ceil(std::max(m.roi.width, m.roi.height) / p.max_roi_px)));
+	const int k = std::max(
+		1, static_cast<int>(std::ceil(std::max(m.roi.width, m.roi.height) / p.max_roi_px)));
 	m.scale = k;
 	m.roi.width -= m.roi.width % k;
 	m.roi.height -= m.roi.height % k;
@@ -89,7 +91,8 @@ EdgelMap findEdgels(const cv::Mat& bgr, const cv::Rect& roi_in, double threshold
 					{
 						const int xx = q.x + ox, yy = q.y + oy;
 						if (xx < 1 || yy < 1 || xx >= W - 1 || yy >= H - 1) continue;
-						if (m.polarity.at<uint8_t>(yy, xx) != cls || seen.at<uint8_t>(yy, xx)) continue;
+						if (m.polarity.at<uint8_t>(yy, xx) != cls || seen.at<uint8_t>(yy, xx))
+							continue;
 						seen.at<uint8_t>(yy, xx) = 1;
 						pts.emplace_back(xx, yy);
 					}
@@ -141,14 +144,16 @@ std::optional<SideSegments> selectSegments(
 	// points along it: 1.5 px inwards, 1 px beyond the edgel's rounding,
 	// keeps a blurred edge (sigma <= 1.5 px) on the fill side and a point
 	// 1.5 px inside the sheet's edge on the frame.
-	const auto fillInImage = [&](const EdgelDomain& d, const Eigen::Vector2d& inward) {
+	const auto fillInImage = [&](const EdgelDomain& d, const Eigen::Vector2d& inward)
+	{
 		if (!bgr) return true;
 		int hits = 0;
 		const double reach = 1.5 + 0.5 * (d.pixel_px - 1);
 		for (const double t : {-0.25, 0.0, 0.25})
 		{
 			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
-			const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+			const int x = static_cast<int>(std::lround(q.x())),
+					  y = static_cast<int>(std::lround(q.y()));
 			if (x < 0 || y < 0 || x >= bgr->cols || y >= bgr->rows) continue;
 			const uint8_t* px = bgr->ptr<uint8_t>(y) + 3 * x;
 			if (px[1] >= 0.5 * c.fill_g && px[1] > px[0] && px[1] > px[2]) ++hits;
@@ -159,7 +164,8 @@ std::optional<SideSegments> selectSegments(
 	// two of three points along it? Rejects edges outside the frame (the
 	// sheet against the wall), which the fill's bounding box may come near
 	// when the codec smears the green over the thin frame.
-	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward) {
+	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward)
+	{
 		int hits = 0;
 		// The domain's position is known to half a pixel of its gradient
 		// image.
@@ -167,8 +173,10 @@ std::optional<SideSegments> selectSegments(
 		for (const double t : {-0.25, 0.0, 0.25})
 		{
 			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
-			const int x = static_cast<int>(std::floor(q.x() / step)), y = static_cast<int>(std::floor(q.y() / step));
-			if (x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x)) ++hits;
+			const int x = static_cast<int>(std::floor(q.x() / step)),
+					  y = static_cast<int>(std::floor(q.y() / step));
+			if (x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x))
+				++hits;
 		}
 		return hits >= 2;
 	};
@@ -186,9 +194,9 @@ std::optional<SideSegments> selectSegments(
 		// outside the frame a frame width and more outside it).
 		const int axis = vertical_side ? 0 : 1;
 		const bool low_side = pol == Polarity::Left || pol == Polarity::Top;
-		const double bbox_side = low_side
-			? (axis == 0 ? c.bbox.x : c.bbox.y) - 0.5
-			: (axis == 0 ? c.bbox.x + c.bbox.width : c.bbox.y + c.bbox.height) - 0.5;
+		const double bbox_side =
+			low_side ? (axis == 0 ? c.bbox.x : c.bbox.y) - 0.5
+					 : (axis == 0 ? c.bbox.x + c.bbox.width : c.bbox.y + c.bbox.height) - 0.5;
 		const EdgelDomain* best = nullptr;
 		double best_dist = std::numeric_limits<double>::max();
 		for (const auto& d : domains)
@@ -198,7 +206,8 @@ std::optional<SideSegments> selectSegments(
 			if (d.length_px < p.min_rel_length * extent) continue;
 			// Along the side: a vertical side's direction is mostly vertical.
 			if (std::abs(d.dir(1 - axis)) < std::abs(d.dir(axis))) continue;
-			if (low_side ? d.mean(axis) >= c.centroid(axis) : d.mean(axis) <= c.centroid(axis)) continue;
+			if (low_side ? d.mean(axis) >= c.centroid(axis) : d.mean(axis) <= c.centroid(axis))
+				continue;
 			Eigen::Vector2d inward = Eigen::Vector2d::Zero();
 			inward(axis) = low_side ? 1 : -1;
 			if (!mask.empty() && !fillInside(d, inward)) continue;

@@ -13,11 +13,21 @@ std::string jsonString(const std::string& s)
 	{
 		switch (c)
 		{
-			case '"': out += "\\\""; break;
-			case '\\': out += "\\\\"; break;
-			case '\n': out += "\\n"; break;
-			case '\r': out += "\\r"; break;
-			case '\t': out += "\\t"; break;
+			case '"':
+				out += "\\\"";
+				break;
+			case '\\':
+				out += "\\\\";
+				break;
+			case '\n':
+				out += "\\n";
+				break;
+			case '\r':
+				out += "\\r";
+				break;
+			case '\t':
+				out += "\\t";
+				break;
 			default:
 				if (c < 0x20)
 				{
@@ -45,8 +55,9 @@ std::string imageToJson(
 	const std::vector<DetectedLandmark>& dets, const std::vector<JsonFields>& extra)
 {
 	std::ostringstream o;
-	o << "{\"image\": " << jsonString(image) << ", \"width\": " << width << ", \"height\": " << height
-	  << ", \"time_ms\": " << jsonNumber(time_ms) << ", \"detections\": [";
+	o << "{\"image\": " << jsonString(image) << ", \"width\": " << width
+	  << ", \"height\": " << height << ", \"time_ms\": " << jsonNumber(time_ms)
+	  << ", \"detections\": [";
 	for (size_t i = 0; i < dets.size(); ++i)
 	{
 		const auto& d = dets[i];

@@ -13,12 +13,14 @@ namespace
 {
 void require(bool ok, const char* name, const char* rule)
 {
-	if (!ok) throw std::invalid_argument(std::string("detector option ") + name + " must be " + rule);
+	if (!ok)
+		throw std::invalid_argument(std::string("detector option ") + name + " must be " + rule);
 }
 
 // Keys are "<block>.<field>", e.g. segmentation.step_px.
 template <typename T>
-void readKey(const mrpt::config::CConfigFileBase& c, const std::string& s, const std::string& key, T& v)
+void readKey(
+	const mrpt::config::CConfigFileBase& c, const std::string& s, const std::string& key, T& v)
 {
 	if constexpr (std::is_same_v<T, bool>)
 		v = c.read_bool(s, key, v);
@@ -29,7 +31,8 @@ void readKey(const mrpt::config::CConfigFileBase& c, const std::string& s, const
 }
 
 template <typename T>
-void writeKey(mrpt::config::CConfigFileBase& c, const std::string& s, const std::string& key, const T& v)
+void writeKey(
+	mrpt::config::CConfigFileBase& c, const std::string& s, const std::string& key, const T& v)
 {
 	c.write(s, key, v, -1, -1);
 }
@@ -89,24 +92,35 @@ void DetectorOptions::validate() const
 {
 	const auto& s = segmentation;
 	require(s.step_px >= 1 && s.step_px <= 4, "segmentation.step_px", "in 1..4");
-	require(s.min_intensity >= 0 && s.min_intensity < 255, "segmentation.min_intensity", "in [0, 255)");
-	require(s.hue_min_deg >= 60 && s.hue_min_deg < s.hue_max_deg && s.hue_max_deg <= 180,
+	require(
+		s.min_intensity >= 0 && s.min_intensity < 255, "segmentation.min_intensity", "in [0, 255)");
+	require(
+		s.hue_min_deg >= 60 && s.hue_min_deg < s.hue_max_deg && s.hue_max_deg <= 180,
 		"segmentation.hue_min_deg/hue_max_deg", "60 <= min < max <= 180");
-	require(s.min_saturation >= 0 && s.min_saturation < 1, "segmentation.min_saturation", "in [0, 1)");
+	require(
+		s.min_saturation >= 0 && s.min_saturation < 1, "segmentation.min_saturation", "in [0, 1)");
 	const auto& c = components;
 	require(c.min_area_px >= 1, "components.min_area_px", ">= 1");
-	require(c.max_area_fraction > 0 && c.max_area_fraction <= 1, "components.max_area_fraction", "in (0, 1]");
+	require(
+		c.max_area_fraction > 0 && c.max_area_fraction <= 1, "components.max_area_fraction",
+		"in (0, 1]");
 	require(c.max_compactness >= 1.0 / 6, "components.max_compactness", ">= 1/6 (a filled square)");
 	require(c.max_elongation >= 1, "components.max_elongation", ">= 1");
 	require(c.roi_grow_fraction >= 0 && c.roi_grow_px >= 0, "components.roi_grow_*", ">= 0");
-	require(c.max_frame_ratio > 0 && c.max_side_frame_ratio >= c.max_frame_ratio, "components.max_frame_ratio/max_side_frame_ratio",
+	require(
+		c.max_frame_ratio > 0 && c.max_side_frame_ratio >= c.max_frame_ratio,
+		"components.max_frame_ratio/max_side_frame_ratio",
 		"> 0 and max_side_frame_ratio >= max_frame_ratio");
 	require(c.max_candidates >= 1, "components.max_candidates", ">= 1");
 	require(c.min_centre_cell_px >= 0, "components.min_centre_cell_px", ">= 0");
-	require(edgels.min_gradient > 0 && edgels.rel_gradient >= 0, "edgels.min_gradient/rel_gradient", "> 0 / >= 0");
+	require(
+		edgels.min_gradient > 0 && edgels.rel_gradient >= 0, "edgels.min_gradient/rel_gradient",
+		"> 0 / >= 0");
 	require(edgels.min_edgels >= 2, "edgels.min_edgels", ">= 2");
 	require(edgels.max_roi_px >= 16, "edgels.max_roi_px", ">= 16");
-	require(segments.min_rel_length > 0 && segments.min_rel_length <= 1, "segments.min_rel_length", "in (0, 1]");
+	require(
+		segments.min_rel_length > 0 && segments.min_rel_length <= 1, "segments.min_rel_length",
+		"in (0, 1]");
 	require(segments.max_width_px > 0, "segments.max_width_px", "> 0");
 	require(quads.max_gap_px >= 0 && quads.max_gap_rel >= 0, "quads.max_gap_*", ">= 0");
 	require(quads.min_side_px >= 2, "quads.min_side_px", ">= 2");
@@ -114,23 +128,31 @@ void DetectorOptions::validate() const
 	require(p.corner_margin_px >= 0, "subpixel.corner_margin_px", ">= 0");
 	require(p.search_px >= 1 && p.search_px <= 10, "subpixel.search_px", "in 1..10");
 	require(p.reach_px >= 1 && p.reach_px <= 10, "subpixel.reach_px", "in 1..10");
-	require(p.saturation_level >= 1 && p.saturation_level <= 256, "subpixel.saturation_level", "in 1..256 (256: never)");
+	require(
+		p.saturation_level >= 1 && p.saturation_level <= 256, "subpixel.saturation_level",
+		"in 1..256 (256: never)");
 	require(p.min_frame_px_centroid >= 0, "subpixel.min_frame_px_centroid", ">= 0");
 	require(p.min_rise_rb > 0, "subpixel.min_rise_rb", "> 0");
 	require(p.response_floor >= 0 && p.response_floor < 1, "subpixel.response_floor", "in [0, 1)");
-	require(p.outlier_sigmas > 0 && p.min_outlier_px > 0, "subpixel.outlier_sigmas/min_outlier_px", "> 0");
+	require(
+		p.outlier_sigmas > 0 && p.min_outlier_px > 0, "subpixel.outlier_sigmas/min_outlier_px",
+		"> 0");
 	require(p.min_support >= 3, "subpixel.min_support", ">= 3");
 	require(p.max_rms_px > 0, "subpixel.max_rms_px", "> 0");
-	require(code.patch_fraction > 0 && code.patch_fraction <= 1, "code.patch_fraction", "in (0, 1]");
+	require(
+		code.patch_fraction > 0 && code.patch_fraction <= 1, "code.patch_fraction", "in (0, 1]");
 	require(code.min_contrast >= 0, "code.min_contrast", ">= 0");
-	require(code.max_black_ratio > 0 && code.max_black_ratio < 1, "code.max_black_ratio", "in (0, 1)");
-	require(code.max_side_black_ratio >= code.max_black_ratio && code.max_side_black_ratio < 1,
+	require(
+		code.max_black_ratio > 0 && code.max_black_ratio < 1, "code.max_black_ratio", "in (0, 1)");
+	require(
+		code.max_side_black_ratio >= code.max_black_ratio && code.max_side_black_ratio < 1,
 		"code.max_side_black_ratio", "in [max_black_ratio, 1)");
 	require(code.min_margin >= 0 && code.min_margin < 0.5, "code.min_margin", "in [0, 0.5)");
 	require(std::isfinite(code.border_px), "code.border_px", "finite");
 }
 
-void DetectorOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+void DetectorOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	forEachField(*this, [&](const char* key, auto& v) { readKey(c, s, key, v); });
 	validate();
@@ -138,12 +160,15 @@ void DetectorOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c,
 
 void DetectorOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	forEachField(const_cast<DetectorOptions&>(*this), [&](const char* key, const auto& v) { writeKey(c, s, key, v); });
+	forEachField(
+		const_cast<DetectorOptions&>(*this),
+		[&](const char* key, const auto& v) { writeKey(c, s, key, v); });
 }
 
 DetectorOptions DetectorOptions::load(const std::string& path, const std::string& section)
 {
-	if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot open the detector options file");
+	if (!std::ifstream(path).good())
+		throw std::runtime_error(path + ": cannot open the detector options file");
 	mrpt::config::CConfigFile cfg(path);
 	if (!cfg.sectionExists(section))
 		throw std::runtime_error(path + ": no [" + section + "] section");

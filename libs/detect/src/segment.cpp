@@ -22,8 +22,8 @@ namespace
 struct FillPredicate
 {
 	int min_sum;  // 3 * t_I
-	int sat64;  // saturation: 3 * 64 * min <= sat64 * sum
-	int hue_lo, hue_hi;  // hue_lo * (G - min) <= 120 * (B - R) <= hue_hi * (G - min)
+	int sat64;	// saturation: 3 * 64 * min <= sat64 * sum
+	int hue_lo, hue_hi;	 // hue_lo * (G - min) <= 120 * (B - R) <= hue_hi * (G - min)
 
 	explicit FillPredicate(const SegmentationParams& p)
 		: min_sum(static_cast<int>(std::ceil(3.0 * p.min_intensity))),
@@ -42,7 +42,7 @@ struct FillPredicate
 		const int chroma = g - mn;
 		const int hue = 120 * (b - r);
 		return (sum >= min_sum) & (g > r) & (g > b) & (3 * 64 * mn <= sat64 * sum) &
-			(hue >= hue_lo * chroma) & (hue <= hue_hi * chroma);
+			   (hue >= hue_lo * chroma) & (hue <= hue_hi * chroma);
 	}
 };
 
@@ -100,8 +100,11 @@ int segmentStep2Simd(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pre
 	const cv::v_int16x8 hlo = cv::v_setall_s16(static_cast<short>(pred.hue_lo));
 	const cv::v_int16x8 hhi = cv::v_setall_s16(static_cast<short>(pred.hue_hi));
 	// The predicate on 8 cells whose channels are in the low bytes of u16s.
-	const auto cells = [&](const cv::v_uint8x16& b8, const cv::v_uint8x16& g8, const cv::v_uint8x16& r8) {
-		const cv::v_uint16x8 bu = cv::v_reinterpret_as_u16(b8) & low, gu = cv::v_reinterpret_as_u16(g8) & low,
+	const auto cells =
+		[&](const cv::v_uint8x16& b8, const cv::v_uint8x16& g8, const cv::v_uint8x16& r8)
+	{
+		const cv::v_uint16x8 bu = cv::v_reinterpret_as_u16(b8) & low,
+							 gu = cv::v_reinterpret_as_u16(g8) & low,
 							 ru = cv::v_reinterpret_as_u16(r8) & low;
 		const cv::v_int16x8 b = cv::v_reinterpret_as_s16(bu), g = cv::v_reinterpret_as_s16(gu),
 							r = cv::v_reinterpret_as_s16(ru);
@@ -109,8 +112,10 @@ int segmentStep2Simd(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pre
 		const cv::v_uint16x8 mnu = cv::v_min(bu, ru);
 		const cv::v_int16x8 chroma = g - cv::v_reinterpret_as_s16(mnu);
 		const cv::v_int16x8 hue = cv::v_mul_wrap(k120, b - r);
-		const cv::v_int16x8 ok = (sum > min_sum) & (g > r) & (g > b) &
-			cv::v_reinterpret_as_s16(cv::v_mul_wrap(k192, mnu) <= cv::v_mul_wrap(sat, cv::v_reinterpret_as_u16(sum))) &
+		const cv::v_int16x8 ok =
+			(sum > min_sum) & (g > r) & (g > b) &
+			cv::v_reinterpret_as_s16(
+				cv::v_mul_wrap(k192, mnu) <= cv::v_mul_wrap(sat, cv::v_reinterpret_as_u16(sum))) &
 			(hue >= cv::v_mul_wrap(hlo, chroma)) & (hue <= cv::v_mul_wrap(hhi, chroma));
 		return ok;
 	};
@@ -148,7 +153,8 @@ bool isFillColour(double r, double g, double b, const SegmentationParams& p)
 
 cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
 {
-	if (bgr.type() != CV_8UC3) throw std::invalid_argument("segmentColour: expected a CV_8UC3 image");
+	if (bgr.type() != CV_8UC3)
+		throw std::invalid_argument("segmentColour: expected a CV_8UC3 image");
 	const int s = p.step_px;
 	if (s < 1 || s > 4) throw std::invalid_argument("segmentColour: step_px must be 1..4");
 	cv::Mat mask(bgr.rows / s, bgr.cols / s, CV_8UC1);
@@ -157,13 +163,28 @@ cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
 	// Dispatch to a loop specialised for the step, so the block sums unroll.
 	switch (s * 2 + (p.box_smoothing ? 1 : 0))
 	{
-		case 2: case 3: segmentGrid<1, false>(bgr, mask, pred, 0); break;
-		case 4: segmentGrid<2, false>(bgr, mask, pred, segmentStep2Simd(bgr, mask, pred)); break;
-		case 5: segmentGrid<2, true>(bgr, mask, pred, 0); break;
-		case 6: segmentGrid<3, false>(bgr, mask, pred, 0); break;
-		case 7: segmentGrid<3, true>(bgr, mask, pred, 0); break;
-		case 8: segmentGrid<4, false>(bgr, mask, pred, 0); break;
-		default: segmentGrid<4, true>(bgr, mask, pred, 0); break;
+		case 2:
+		case 3:
+			segmentGrid<1, false>(bgr, mask, pred, 0);
+			break;
+		case 4:
+			segmentGrid<2, false>(bgr, mask, pred, segmentStep2Simd(bgr, mask, pred));
+			break;
+		case 5:
+			segmentGrid<2, true>(bgr, mask, pred, 0);
+			break;
+		case 6:
+			segmentGrid<3, false>(bgr, mask, pred, 0);
+			break;
+		case 7:
+			segmentGrid<3, true>(bgr, mask, pred, 0);
+			break;
+		case 8:
+			segmentGrid<4, false>(bgr, mask, pred, 0);
+			break;
+		default:
+			segmentGrid<4, true>(bgr, mask, pred, 0);
+			break;
 	}
 	return mask;
 }
@@ -174,7 +195,7 @@ namespace
 struct Run
 {
 	int y, x0, x1;
-	int parent;  // union-find
+	int parent;	 // union-find
 };
 
 int findRoot(std::vector<Run>& runs, int i)
@@ -211,7 +232,8 @@ bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const Compo
 {
 	if (p.max_frame_ratio >= 1) return true;
 	std::array<double, 4> side{};
-	const int x0 = c.bbox.x, y0 = c.bbox.y, x1 = c.bbox.x + c.bbox.width - 1, y1 = c.bbox.y + c.bbox.height - 1;
+	const int x0 = c.bbox.x, y0 = c.bbox.y, x1 = c.bbox.x + c.bbox.width - 1,
+			  y1 = c.bbox.y + c.bbox.height - 1;
 	// Rays start a grid step inside the box (its sides are a step coarse) and
 	// reach a frame width (1/8 of the side) plus margins beyond it.
 	const int nx = step + 3 + c.bbox.width / 6, ny = step + 3 + c.bbox.height / 6;
@@ -221,13 +243,22 @@ bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const Compo
 		for (int j = 0; j < 3; ++j)
 		{
 			const double t = 0.25 * (j + 1);
-			const int xm = x0 + static_cast<int>(t * (x1 - x0)), ym = y0 + static_cast<int>(t * (y1 - y0));
+			const int xm = x0 + static_cast<int>(t * (x1 - x0)),
+					  ym = y0 + static_cast<int>(t * (y1 - y0));
 			switch (k)
 			{
-				case 0: m[j] = darkestAlong(bgr, xm, y0 + step, 0, -1, ny); break;  // top
-				case 1: m[j] = darkestAlong(bgr, x1 - step, ym, 1, 0, nx); break;  // right
-				case 2: m[j] = darkestAlong(bgr, xm, y1 - step, 0, 1, ny); break;  // bottom
-				default: m[j] = darkestAlong(bgr, x0 + step, ym, -1, 0, nx); break;  // left
+				case 0:
+					m[j] = darkestAlong(bgr, xm, y0 + step, 0, -1, ny);
+					break;	// top
+				case 1:
+					m[j] = darkestAlong(bgr, x1 - step, ym, 1, 0, nx);
+					break;	// right
+				case 2:
+					m[j] = darkestAlong(bgr, xm, y1 - step, 0, 1, ny);
+					break;	// bottom
+				default:
+					m[j] = darkestAlong(bgr, x0 + step, ym, -1, 0, nx);
+					break;	// left
 			}
 			if (m[j] < 0) return false;
 		}
@@ -240,12 +271,14 @@ bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const Compo
 	return sorted[3] <= p.max_side_frame_ratio * c.fill_g;
 }
 
-bool centreEvidence(const cv::Mat& mask, const Candidate& c, int step, double cell_rel, const ComponentParams& p)
+bool centreEvidence(
+	const cv::Mat& mask, const Candidate& c, int step, double cell_rel, const ComponentParams& p)
 {
 	// The smallest the centre cell can be for this box: the box of a square
 	// turned 45 deg in the image is sqrt(2) times its side.
 	const double extent = std::min(c.bbox.width, c.bbox.height);
-	if (p.min_centre_cell_px <= 0 || cell_rel * extent / std::sqrt(2.0) < p.min_centre_cell_px) return true;
+	if (p.min_centre_cell_px <= 0 || cell_rel * extent / std::sqrt(2.0) < p.min_centre_cell_px)
+		return true;
 	// The box's centre lies within the centre cell: perspective moves it off
 	// the square's centre by a s / (2 Z) of the width (a: half side, s: sine
 	// of the angle, Z: distance; 7% at 0.5 m and 60 deg), less than half a
@@ -269,8 +302,8 @@ inline double sumSquares(double k) { return k * (k + 1) * (2 * k + 1) / 6; }  //
 }  // namespace
 
 std::vector<Candidate> findCandidates(
-	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p, cv::Mat* labels_out,
-	int* num_components, double centre_cell_rel)
+	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
+	cv::Mat* labels_out, int* num_components, double centre_cell_rel)
 {
 	// N4-connected components by runs and union-find, hand-written because
 	// the moments up to second order then come per run in closed form, and a
@@ -308,7 +341,8 @@ std::vector<Candidate> findCandidates(
 			while (j < prev_end && runs[j].x1 <= runs[i].x0) ++j;
 			for (size_t k = j; k < prev_end && runs[k].x0 < runs[i].x1; ++k)
 			{
-				const int a = findRoot(runs, static_cast<int>(i)), b = findRoot(runs, static_cast<int>(k));
+				const int a = findRoot(runs, static_cast<int>(i)),
+						  b = findRoot(runs, static_cast<int>(k));
 				if (a != b) runs[std::max(a, b)].parent = std::min(a, b);
 			}
 		}
@@ -361,22 +395,27 @@ std::vector<Candidate> findCandidates(
 		const double m0 = mo.m0, mx = mo.sx / m0, my = mo.sy / m0;
 		// Central moments per unit mass, with the 1/12 of each unit cell (a
 		// cell is a square, not a point).
-		const double mu20 = mo.sxx / m0 - mx * mx + 1.0 / 12, mu02 = mo.syy / m0 - my * my + 1.0 / 12;
+		const double mu20 = mo.sxx / m0 - mx * mx + 1.0 / 12,
+					 mu02 = mo.syy / m0 - my * my + 1.0 / 12;
 		const double mu11 = mo.sxy / m0 - mx * my;
 		Candidate c;
 		c.label = static_cast<int>(l) + 1;
-		c.compactness = (mu20 + mu02) / m0;  // (mu20 + mu02) / m00^2 for raw sums
+		c.compactness = (mu20 + mu02) / m0;	 // (mu20 + mu02) / m00^2 for raw sums
 		const double tr = mu20 + mu02, det = mu20 * mu02 - mu11 * mu11;
 		const double disc = std::sqrt(std::max(0.0, tr * tr / 4 - det));
 		const double l1 = tr / 2 + disc, l2 = std::max(tr / 2 - disc, 1e-9);
 		c.elongation = std::sqrt(l1 / l2);
 		if (c.compactness > p.max_compactness || c.elongation > p.max_elongation) continue;
 		c.area_px = area;
-		c.bbox = cv::Rect(mo.x0 * step, mo.y0 * step, (mo.x1 - mo.x0 + 1) * step, (mo.y1 - mo.y0 + 1) * step);
+		c.bbox = cv::Rect(
+			mo.x0 * step, mo.y0 * step, (mo.x1 - mo.x0 + 1) * step, (mo.y1 - mo.y0 + 1) * step);
 		c.centroid = {mx * step + 0.5 * (step - 1), my * step + 0.5 * (step - 1)};
-		const int gx = static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.width)) + p.roi_grow_px;
-		const int gy = static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.height)) + p.roi_grow_px;
-		c.roi = cv::Rect(c.bbox.x - gx, c.bbox.y - gy, c.bbox.width + 2 * gx, c.bbox.height + 2 * gy) &
+		const int gx =
+			static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.width)) + p.roi_grow_px;
+		const int gy =
+			static_cast<int>(std::ceil(p.roi_grow_fraction * c.bbox.height)) + p.roi_grow_px;
+		c.roi =
+			cv::Rect(c.bbox.x - gx, c.bbox.y - gy, c.bbox.width + 2 * gx, c.bbox.height + 2 * gy) &
 			cv::Rect(0, 0, bgr.cols, bgr.rows);
 		out.push_back(c);
 		keep[l] = 1;
@@ -396,14 +435,18 @@ std::vector<Candidate> findCandidates(
 		// Along short rays outwards from each side of the bounding box, the
 		// darkest G must be dark: cheap, and it spares the later stages most
 		// green things of a scene (posters, shapes on a wall).
-		out.erase(std::remove_if(out.begin(), out.end(),
-					  [&](const Candidate& c) {
-						  return !centreEvidence(mask, c, step, centre_cell_rel, p) ||
-							  !frameEvidence(bgr, c, step, p);
-					  }),
+		out.erase(
+			std::remove_if(
+				out.begin(), out.end(),
+				[&](const Candidate& c) {
+					return !centreEvidence(mask, c, step, centre_cell_rel, p) ||
+						   !frameEvidence(bgr, c, step, p);
+				}),
 			out.end());
 	}
-	std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.area_px > b.area_px; });
+	std::sort(
+		out.begin(), out.end(),
+		[](const Candidate& a, const Candidate& b) { return a.area_px > b.area_px; });
 	if (static_cast<int>(out.size()) > p.max_candidates) out.resize(p.max_candidates);
 	return out;
 }

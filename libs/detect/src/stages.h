@@ -34,14 +34,14 @@ bool isFillColour(double r, double g, double b, const SegmentationParams& p);
  * one candidate green fill. Coordinates in full-image pixels. */
 struct Candidate
 {
-	int label = 0;  //!< label in the components image
-	cv::Rect bbox;  //!< bounding box of the component's blocks [px]
+	int label = 0;	//!< label in the components image
+	cv::Rect bbox;	//!< bounding box of the component's blocks [px]
 	cv::Rect roi;  //!< bbox grown to include the black frame, clipped [px]
-	Eigen::Vector2d centroid = Eigen::Vector2d::Zero();  //!< [px]
-	double area_px = 0;  //!< number of blocks x step^2 [px^2]
-	double compactness = 0;  //!< eta20 + eta02 (Hu's first invariant)
-	double elongation = 0;  //!< ratio of principal standard deviations
-	double fill_g = 0;  //!< mean G of the component's blocks [grey levels]
+	Eigen::Vector2d centroid = Eigen::Vector2d::Zero();	 //!< [px]
+	double area_px = 0;	 //!< number of blocks x step^2 [px^2]
+	double compactness = 0;	 //!< eta20 + eta02 (Hu's first invariant)
+	double elongation = 0;	//!< ratio of principal standard deviations
+	double fill_g = 0;	//!< mean G of the component's blocks [grey levels]
 };
 
 /** N4-connected components of \a mask (from segmentColour with grid step
@@ -61,8 +61,8 @@ enum class Polarity : uint8_t
 {
 	None = 0,
 	Top = 1,  //!< G rises downwards (+v): the top inner edge
-	Right = 2,  //!< G falls rightwards (-u): the right inner edge
-	Bottom = 3,  //!< G falls downwards (-v): the bottom inner edge
+	Right = 2,	//!< G falls rightwards (-u): the right inner edge
+	Bottom = 3,	 //!< G falls downwards (-v): the bottom inner edge
 	Left = 4  //!< G rises rightwards (+u): the left inner edge
 };
 
@@ -70,23 +70,24 @@ enum class Polarity : uint8_t
 struct EdgelDomain
 {
 	Polarity polarity = Polarity::None;
-	int count = 0;  //!< number of edgels
-	Eigen::Vector2d mean = Eigen::Vector2d::Zero();  //!< centroid [px]
-	Eigen::Vector2d dir = Eigen::Vector2d::UnitX();  //!< principal direction (unit)
+	int count = 0;	//!< number of edgels
+	Eigen::Vector2d mean = Eigen::Vector2d::Zero();	 //!< centroid [px]
+	Eigen::Vector2d dir = Eigen::Vector2d::UnitX();	 //!< principal direction (unit)
 	double length_px = 0;  //!< extent along dir (max - min projection) [px]
 	double width_px = 0;  //!< sqrt of the smaller eigenvalue (slimness) [px]
 	/** Size of a pixel of the gradient image the domain was found in [px]
 	 * (EdgelMap::scale): a straight edge's edgels there form a staircase
 	 * whose width is a fraction of that pixel. */
 	double pixel_px = 1;
-	Eigen::Vector2d end0 = Eigen::Vector2d::Zero(), end1 = Eigen::Vector2d::Zero();  //!< extreme edgels along dir
+	Eigen::Vector2d end0 = Eigen::Vector2d::Zero(),
+					end1 = Eigen::Vector2d::Zero();	 //!< extreme edgels along dir
 };
 
 /** Edgels of one ROI. */
 struct EdgelMap
 {
 	cv::Rect roi;  //!< in full-image pixels
-	int scale = 1;  //!< reduction factor of the gradient image (large ROIs)
+	int scale = 1;	//!< reduction factor of the gradient image (large ROIs)
 	cv::Mat polarity;  //!< CV_8UC1 of roi size / scale, Polarity values
 	std::vector<EdgelDomain> domains;  //!< with at least min_edgels edgels
 	double threshold = 0;  //!< gradient threshold used [grey levels / px]
@@ -151,7 +152,7 @@ struct LineFit
 {
 	Eigen::Vector2d normal = Eigen::Vector2d::UnitX();
 	double c = 0;
-	double rms_px = 0;  //!< RMS distance of the kept points [px]
+	double rms_px = 0;	//!< RMS distance of the kept points [px]
 	int support = 0;  //!< number of kept points
 	std::vector<Eigen::Vector2d> points;  //!< all edge points given (debug)
 };
@@ -164,7 +165,7 @@ std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> points, const Subpix
 struct RefinedQuad
 {
 	Quad corners_raw;  //!< TL, TR, BR, BL in raw (distorted) pixels
-	Quad corners_ideal;  //!< the same undistorted
+	Quad corners_ideal;	 //!< the same undistorted
 	std::array<LineFit, 4> sides;  //!< top, right, bottom, left, in undistorted px
 };
 
@@ -182,11 +183,11 @@ std::optional<RefinedQuad> refineQuadrangle(
 struct CodeReading
 {
 	int id = -1;
-	CodeCells cells{};  //!< true = black
-	std::array<double, 9> cell_g{};  //!< mean G of each cell, row by row
-	double black_g = 0;  //!< G of the black frame
-	double green_g = 0;  //!< G of the green fill
-	double margin = 0;  //!< smallest |cell - threshold| [grey levels]
+	CodeCells cells{};	//!< true = black
+	std::array<double, 9> cell_g{};	 //!< mean G of each cell, row by row
+	double black_g = 0;	 //!< G of the black frame
+	double green_g = 0;	 //!< G of the green fill
+	double margin = 0;	//!< smallest |cell - threshold| [grey levels]
 };
 
 /** Homography from normalised face coordinates (s/h right, t/h up; the
@@ -201,7 +202,7 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v);
  * reads the 3x3 cells; nullopt when any check fails, the centre cell is
  * green or a cell is ambiguous. */
 std::optional<CodeReading> readCode(
-	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera,
-	const LandmarkGeometry& g, const CodeParams& p);
+	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
+	const CodeParams& p);
 
 }  // namespace codemark::detect

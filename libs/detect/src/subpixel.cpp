@@ -64,16 +64,19 @@ std::optional<double> locateRisingEdge(
 		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < peak)
 		{
 			int lowest = d(ko);
-			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, peak - 1); ++k) lowest = std::min(lowest, d(k));
+			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, peak - 1); ++k)
+				lowest = std::min(lowest, d(k));
 			if (lowest < 0)
 			{
 				double amp = dp;
 				for (int it = 0; it < 4 && var > 0; ++it)
 				{
 					const double o = e - neighbour_px;
-					const double g = [&] { return std::exp(-neighbour_px * neighbour_px / (2 * var)); }();
+					const double g = [&]
+					{ return std::exp(-neighbour_px * neighbour_px / (2 * var)); }();
 					const double B = -lowest + amp * g;
-					const auto lobe = [&](int k) { return B * std::exp(-(k - o) * (k - o) / (2 * var)); };
+					const auto lobe = [&](int k)
+					{ return B * std::exp(-(k - o) * (k - o) / (2 * var)); };
 					const double a = d(km) + lobe(km), b = dp + lobe(peak), c = d(kp) + lobe(kp);
 					double v2 = 0;
 					const double off = peakOffset(a, b, c, v2);
@@ -210,10 +213,13 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// Perspective: the frame next to this side is wider or narrower than
 		// the average in the ratio of this side's length (its local scale)
 		// to the mean of it and the opposite side's.
-		const double own = ab.norm(), opposite = (coarse[(side + 3) % 4] - coarse[(side + 2) % 4]).norm();
-		const double frame_px = frame_ratio * 0.5 * (std::abs(prev_side(across)) + std::abs(next_side(across))) *
-			(own + opposite > 0 ? 2 * own / (own + opposite) : 1.0);
-		const EdgeMode mode = frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
+		const double own = ab.norm(),
+					 opposite = (coarse[(side + 3) % 4] - coarse[(side + 2) % 4]).norm();
+		const double frame_px = frame_ratio * 0.5 *
+								(std::abs(prev_side(across)) + std::abs(next_side(across))) *
+								(own + opposite > 0 ? 2 * own / (own + opposite) : 1.0);
+		const EdgeMode mode =
+			frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
 		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
 		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
 		// First pass: read the profiles (G and -(R + B), across the side,
@@ -228,12 +234,14 @@ std::optional<RefinedQuad> refineQuadrangle(
 			const int c0 = static_cast<int>(std::lround(cpred));
 			// Profile index i <-> across coordinate c0 + inward * (i - half).
 			const int c_first = c0 - half, c_last = c0 + half;
-			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H)) continue;
+			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H))
+				continue;
 			double fill_sum = 0;
 			for (int i = 0; i < n; ++i)
 			{
 				const int c = c0 + inward * (i - half);
-				const uint8_t* px = along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
+				const uint8_t* px =
+					along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
 				g_prof.push_back(px[1]);
 				rb_prof.push_back(-(px[0] + px[2]));
 				if (i >= hi + 2) fill_sum += px[1];
@@ -277,23 +285,28 @@ std::optional<RefinedQuad> refineQuadrangle(
 			// The edge must have the green fill just inside it (G above R + B
 			// two pixels inwards): the sheet's edge against a darker wall
 			// rises inwards too, a frame width and a margin outside.
-			const auto greenInside = [&](double e) {
+			const auto greenInside = [&](double e)
+			{
 				const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
 				return gp[i] > -rbp[i];
 			};
-			const auto locate = [&](int l, int h) -> std::optional<double> {
+			const auto locate = [&](int l, int h) -> std::optional<double>
+			{
 				if (!side_saturated)
-					return locateRisingEdge(gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
+					return locateRisingEdge(
+						gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
 				// In R + B the frame's outer edge (white to black) rises too,
 				// a frame width away: search only next to the G peak and stop
 				// the response where it stops falling.
 				const auto g_peak = locateRisingEdge(
-					gp, n, l, h, min_rise, p, EdgeMode::Peak, p.model_outer_edge && !side_clipped ? frame_px : 0.0);
+					gp, n, l, h, min_rise, p, EdgeMode::Peak,
+					p.model_outer_edge && !side_clipped ? frame_px : 0.0);
 				if (!g_peak) return std::nullopt;
 				std::optional<double> r;
 				const int k = static_cast<int>(std::lround(*g_peak));
 				if (side_clipped && mode == EdgeMode::Centroid)
-					r = locateRisingEdge(rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
+					r = locateRisingEdge(
+						rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
 				return r ? r : g_peak;
 			};
 			std::optional<double> e = locate(lo, hi);
@@ -305,7 +318,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 			}
 			if (!e) continue;
 			const double c = origin[j] + inward * (*e - half);
-			Eigen::Vector2d pt = along == 1 ? Eigen::Vector2d(c, pos[j]) : Eigen::Vector2d(pos[j], c);
+			Eigen::Vector2d pt =
+				along == 1 ? Eigen::Vector2d(c, pos[j]) : Eigen::Vector2d(pos[j], c);
 			// Lines are straight only without distortion: fit undistorted.
 			if (distorted) pt = cam.undistortPixel(pt);
 			pts.push_back(pt);

@@ -26,10 +26,10 @@ using mrpt::poses::CPose2D;
 
 void EkfOptions::validate() const
 {
-	auto bad = [](const std::string& key, const std::string& why) {
-		throw std::invalid_argument("[ekf] " + key + ": " + why);
-	};
-	if (!(gate_probability > 0 && gate_probability < 1)) bad("gate_probability", "must be in (0, 1)");
+	auto bad = [](const std::string& key, const std::string& why)
+	{ throw std::invalid_argument("[ekf] " + key + ": " + why); };
+	if (!(gate_probability > 0 && gate_probability < 1))
+		bad("gate_probability", "must be in (0, 1)");
 	if (kidnap_rejections < 0) bad("kidnap_rejections", "must be >= 0");
 	if (!(measurement_cov_scale > 0)) bad("measurement_cov_scale", "must be > 0");
 	if (!(extra_motion_var_xy_m2 >= 0)) bad("extra_motion_var_xy_m2", "must be >= 0");
@@ -117,7 +117,7 @@ void symmetriseAndCheckCovariance(
 		os << what << ": covariance has non-finite entries:\n" << P;
 		throw std::runtime_error(os.str());
 	}
-	P = (0.5 * (P + P.transpose())).eval();  // eval: P.transpose() aliases P
+	P = (0.5 * (P + P.transpose())).eval();	 // eval: P.transpose() aliases P
 	Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(P);
 	const Eigen::Vector3d ev = es.eigenvalues();  // ascending
 	if (ev[0] < -tolerance * std::max(1.0, ev[2]))
@@ -143,7 +143,7 @@ struct Sighting
 {
 	const CObservationCodedLandmarks::TSighting* s = nullptr;
 	const MapLandmark* landmark = nullptr;
-	CPose2D robot_T_camera;  // planar camera mounting
+	CPose2D robot_T_camera;	 // planar camera mounting
 	CPose2D world_T_landmark;  // planar landmark pose
 };
 
@@ -178,7 +178,10 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		}
 	}
 
-	std::string method() const override { return kind_ == EkfMeasurement::Landmark ? "ekf" : "ekf-pose"; }
+	std::string method() const override
+	{
+		return kind_ == EkfMeasurement::Landmark ? "ekf" : "ekf-pose";
+	}
 
 	PoseEstimate estimate() const override
 	{
@@ -203,7 +206,8 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 			u_ = {mean.x(), mean.y(), mean.phi()};
 			C_u_ = C.asEigen();
 			if (!u_.allFinite() || !C_u_.allFinite())
-				throw std::runtime_error("ekf: odometry increment with non-finite mean or covariance");
+				throw std::runtime_error(
+					"ekf: odometry increment with non-finite mean or covariance");
 			predict_ = initialized_;
 		}
 
@@ -212,7 +216,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		for (const auto& obs : observations)
 		{
 			const auto* lm_obs = dynamic_cast<const CObservationCodedLandmarks*>(obs.get());
-			if (!lm_obs) continue;  // BearingRange twins would count the same sightings twice
+			if (!lm_obs) continue;	// BearingRange twins would count the same sightings twice
 			const CPose2D cam = pose::cameraPlanarPose(lm_obs->cameraPose);
 			for (const auto& s : lm_obs->sightings)
 			{
@@ -339,8 +343,9 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		const Eigen::LDLT<Eigen::Matrix3d> P0_inv(P0), R_inv(R_);
 		auto cost = [&](const Eigen::Vector3d& x)
 		{
-			Eigen::Vector3d dx = x - x0_, nu = z_ -
-				predictLandmarkMeasurement(x, current_->robot_T_camera, current_->world_T_landmark);
+			Eigen::Vector3d dx = x - x0_,
+							nu = z_ - predictLandmarkMeasurement(
+										  x, current_->robot_T_camera, current_->world_T_landmark);
 			dx[2] = wrapToPi(dx[2]);
 			nu[1] = wrapToPi(nu[1]);
 			nu[2] = wrapToPi(nu[2]);
@@ -349,8 +354,8 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		double ci = cost(xi);
 		for (int it = 1; it < opt_.iterations; ++it)
 		{
-			const Eigen::Vector3d h =
-				predictLandmarkMeasurement(xi, current_->robot_T_camera, current_->world_T_landmark, &H);
+			const Eigen::Vector3d h = predictLandmarkMeasurement(
+				xi, current_->robot_T_camera, current_->world_T_landmark, &H);
 			Eigen::Vector3d nu = z_ - h, dx = x0_ - xi;
 			nu[1] = wrapToPi(nu[1]);
 			nu[2] = wrapToPi(nu[2]);
@@ -373,7 +378,8 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		// Joseph form: symmetric and positive semi-definite by construction.
 		const Eigen::Matrix3d I_KH = Eigen::Matrix3d::Identity() - K * H;
 		Eigen::Matrix3d P = I_KH * P0 * I_KH.transpose() + K * R_ * K.transpose();
-		symmetriseAndCheckCovariance(P, opt_.pd_tolerance, opt_.min_eigenvalue, "ekf (iterated update)");
+		symmetriseAndCheckCovariance(
+			P, opt_.pd_tolerance, opt_.min_eigenvalue, "ekf (iterated update)");
 		setState(xi, P);
 	}
 
@@ -413,8 +419,10 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 
 	void OnGetObservationNoise(KFMatrix_OxO& out_R) const override
 	{
-		if (current_) out_R.asEigen() = R_;
-		else out_R.setIdentity();
+		if (current_)
+			out_R.asEigen() = R_;
+		else
+			out_R.setIdentity();
 	}
 
 	void OnObservationModel(const std::vector<size_t>&, vector_KFArray_OBS& out) const override
@@ -425,8 +433,9 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		const Eigen::Vector3d x(m_xkk[0], m_xkk[1], m_xkk[2]);
 		if (current_)
 			h = kind_ == EkfMeasurement::Landmark
-				? predictLandmarkMeasurement(x, current_->robot_T_camera, current_->world_T_landmark)
-				: x;
+					? predictLandmarkMeasurement(
+						  x, current_->robot_T_camera, current_->world_T_landmark)
+					: x;
 		for (int i = 0; i < 3; ++i) out[0][i] = h[i];
 	}
 
@@ -495,7 +504,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	Eigen::Vector3d z_ = Eigen::Vector3d::Zero();
 	Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
 	bool accepted_ = false;
-	Eigen::Vector3d x0_ = Eigen::Vector3d::Zero();  // prior of the accepted update
+	Eigen::Vector3d x0_ = Eigen::Vector3d::Zero();	// prior of the accepted update
 	Eigen::Matrix3d P0_ = Eigen::Matrix3d::Zero();
 };
 }  // namespace

@@ -63,7 +63,8 @@ void EkfSlamOptions::loadFromConfigFile(
 	const std::string in = c.read_string(s, "input", "", false);
 	if (!in.empty())
 	{
-		if (in == "auto") input = SlamInput::Auto;
+		if (in == "auto")
+			input = SlamInput::Auto;
 		else if (in == "coded")
 			input = SlamInput::Coded;
 		else if (in == "bearing_range")
@@ -78,7 +79,8 @@ void EkfSlamOptions::loadFromConfigFile(
 	const std::string lm = c.read_string(s, "landmarks", "", false);
 	if (!lm.empty())
 	{
-		if (lm == "auto") landmarks = SlamLandmarks::Auto;
+		if (lm == "auto")
+			landmarks = SlamLandmarks::Auto;
 		else if (lm == "full")
 			landmarks = SlamLandmarks::Full;
 		else if (lm == "point")
@@ -146,13 +148,13 @@ Eigen::Vector3d slamObservation(
 	{
 		// d(sx, sy)/d(yaw) = (-oy, ox).
 		*Hx << -dx / r, -dy / r, (dx * oy - dy * ox) / r,  //
-			dy / r2, -dx / r2, -(dy * oy + dx * ox) / r2 - 1.0,  //
+			dy / r2, -dx / r2, -(dy * oy + dx * ox) / r2 - 1.0,	 //
 			0.0, 0.0, 1.0;
 	}
 	if (Hy)
 	{
-		*Hy << dx / r, dy / r, 0.0,  //
-			-dy / r2, dx / r2, 0.0,  //
+		*Hy << dx / r, dy / r, 0.0,	 //
+			-dy / r2, dx / r2, 0.0,	 //
 			0.0, 0.0, -1.0;
 	}
 	return h;
@@ -178,8 +180,8 @@ Eigen::Vector3d slamInverseObservation(
 	}
 	if (Jz)
 	{
-		*Jz << cb, -z[0] * sb, 0.0,  //
-			sb, z[0] * cb, 0.0,  //
+		*Jz << cb, -z[0] * sb, 0.0,	 //
+			sb, z[0] * cb, 0.0,	 //
 			0.0, 0.0, -1.0;
 	}
 	return l;
@@ -195,13 +197,14 @@ struct Sighting
 {
 	int id = -1;
 	Eigen::Vector3d z = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] or [range yaw 0]
-	Eigen::Matrix3d C = Eigen::Matrix3d::Identity();  //!< covariance of z (dummy 1 on the third for points)
+	Eigen::Matrix3d C =
+		Eigen::Matrix3d::Identity();  //!< covariance of z (dummy 1 on the third for points)
 	/** Whitening W = chol(C)^-1 (lower triangular, so its top-left 2x2
 	 * block whitens the range-bearing part alone). */
 	Eigen::Matrix3d W = Eigen::Matrix3d::Identity();
 	mrpt::poses::CPose2D sensor;  //!< sensor's planar pose on the robot
-	bool point = false;  //!< range-bearing: the third component is unused
-	double height_m = std::numeric_limits<double>::quiet_NaN();  //!< landmark z estimate
+	bool point = false;	 //!< range-bearing: the third component is unused
+	double height_m = std::numeric_limits<double>::quiet_NaN();	 //!< landmark z estimate
 	// Coded only, for the pose fix that anchors a prior map.
 	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();
 	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();
@@ -249,14 +252,14 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 	std::vector<LandmarkInfo> info;
 
 	// Per Kalman iteration.
-	std::vector<Sighting> pass;  //!< this iteration's sightings, one per landmark at most
+	std::vector<Sighting> pass;	 //!< this iteration's sightings, one per landmark at most
 	std::vector<int> sighting_of;  //!< landmark index -> index in pass, or -1
-	mutable std::vector<MatD> t_of;  //!< per pass index: transform(), once computed
-	mutable std::vector<bool> t_ready;  //!< per pass index: t_of is computed
+	mutable std::vector<MatD> t_of;	 //!< per pass index: transform(), once computed
+	mutable std::vector<bool> t_ready;	//!< per pass index: t_of is computed
 	bool skip_prediction = false;
-	mrpt::poses::CPose2D odo_mean;  //!< odometry increment in the robot frame
+	mrpt::poses::CPose2D odo_mean;	//!< odometry increment in the robot frame
 	Eigen::Matrix3d odo_cov = Eigen::Matrix3d::Zero();
-	std::vector<std::size_t> new_queue;  //!< pass indices of sightings to add, in order
+	std::vector<std::size_t> new_queue;	 //!< pass indices of sightings to add, in order
 	mutable std::size_t new_cursor = 0;
 	int used = 0, rejected = 0;
 	std::size_t iterations = 0;
@@ -408,18 +411,21 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 		P = 0.5 * (P + P.transpose()).eval();
 		if (!P.allFinite()) fail("non-finite entries");
 		const Eigen::VectorXd d = P.diagonal();
-		const Eigen::MatrixXd excess =
-			P.cwiseAbs2() - (d * d.transpose()) * (1.0 + 1e-6) - Eigen::MatrixXd::Constant(P.rows(), P.cols(), tol);
+		const Eigen::MatrixXd excess = P.cwiseAbs2() - (d * d.transpose()) * (1.0 + 1e-6) -
+									   Eigen::MatrixXd::Constant(P.rows(), P.cols(), tol);
 		Eigen::Index r = 0, c = 0;
 		if (excess.maxCoeff(&r, &c) > 0)
-			fail("entry (" + std::to_string(r) + ", " + std::to_string(c) + ") = " + std::to_string(P(r, c)) +
-				" exceeds its 2x2 principal minor");
+			fail(
+				"entry (" + std::to_string(r) + ", " + std::to_string(c) +
+				") = " + std::to_string(P(r, c)) + " exceeds its 2x2 principal minor");
 		auto checkBlock = [&](const auto& B, Eigen::Index o)
 		{
 			using M = std::decay_t<decltype(B)>;
-			const auto ev = Eigen::SelfAdjointEigenSolver<M>(B, Eigen::EigenvaluesOnly).eigenvalues();
+			const auto ev =
+				Eigen::SelfAdjointEigenSolver<M>(B, Eigen::EigenvaluesOnly).eigenvalues();
 			if (ev.minCoeff() < -tol * std::max(1.0, ev.maxCoeff()))
-				fail((o == 0 ? std::string("robot") : "landmark " + std::to_string((o - 3) / D)) +
+				fail(
+					(o == 0 ? std::string("robot") : "landmark " + std::to_string((o - 3) / D)) +
 					" block has eigenvalue " + std::to_string(ev.minCoeff()));
 		};
 		checkBlock(Eigen::Matrix3d(P.template block<3, 3>(0, 0)), 0);
@@ -484,8 +490,7 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 			if (sighting_of[i] >= 0) out.push_back(i);
 	}
 
-	void OnObservationModel(
-		const std::vector<size_t>& idxs, vector_KFArray_OBS& out) const override
+	void OnObservationModel(const std::vector<size_t>& idxs, vector_KFArray_OBS& out) const override
 	{
 		out.resize(idxs.size());
 		for (std::size_t k = 0; k < idxs.size(); ++k)
@@ -540,12 +545,13 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 				continue;
 			}
 			const std::size_t idx = it->second;
-			const VecD nu = z - predictNear(s, idx, nullptr, nullptr);  // wrapped
+			const VecD nu = z - predictNear(s, idx, nullptr, nullptr);	// wrapped
 			const MatD& T = transform(i, idx);
 			const VecD w = T * nu;
 			std::size_t k = 0;
 			while (k < in_idx_S.size() && in_idx_S[k] != idx) ++k;
-			if (k == in_idx_S.size()) throw std::logic_error("ekf-slam: sighted landmark not predicted");
+			if (k == in_idx_S.size())
+				throw std::logic_error("ekf-slam: sighted landmark not predicted");
 			const MatD S = in_S.asEigen().template block<D, D>(D * k, D * k);
 			const double d2 = w.dot(S.ldlt().solve(w));
 			if (!(d2 <= gateThreshold(opts.gate_probability, (D == 2 || s.point) ? 2 : 3)))
@@ -629,8 +635,8 @@ class EkfSlam::Impl
 {
    public:
 	EkfSlamOptions opts;
-	std::unique_ptr<SlamKF<3>> k3;  //!< full landmarks
-	std::unique_ptr<SlamKF<2>> k2;  //!< point landmarks (range-bearing-only data)
+	std::unique_ptr<SlamKF<3>> k3;	//!< full landmarks
+	std::unique_ptr<SlamKF<2>> k2;	//!< point landmarks (range-bearing-only data)
 	std::optional<PoseEstimate> initial;
 	LandmarkMap prior;
 	/** The Kalman template's options (TKF_options holds a reference, so it
@@ -714,7 +720,7 @@ class EkfSlam::Impl
 			if (std::dynamic_pointer_cast<CObservationCodedLandmarks>(obs)) has_coded = true;
 		const bool take_coded = o.input != SlamInput::BearingRange;
 		const bool take_br = o.input == SlamInput::BearingRange || o.input == SlamInput::Both ||
-			(o.input == SlamInput::Auto && !has_coded);
+							 (o.input == SlamInput::Auto && !has_coded);
 		std::vector<Sighting> out;
 		for (const auto& obs : sf)
 		{
@@ -740,12 +746,14 @@ class EkfSlam::Impl
 						for (const auto& p : t.corners) v += 0.25 * p.y();
 						s.height_m = c->cameraPose.z() - t.L[0] * (v - c->camera.cy()) / fy;
 					}
-					if (whiten(s)) out.push_back(s);
+					if (whiten(s))
+						out.push_back(s);
 					else
 						++rejected;
 				}
 			}
-			else if (const auto b = std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(obs);
+			else if (const auto b =
+						 std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(obs);
 					 b && take_br)
 			{
 				const mrpt::poses::CPose2D sensor(b->sensorLocationOnRobot);
@@ -771,7 +779,8 @@ class EkfSlam::Impl
 					s.C(2, 2) = 1.0;  // the unused component: unit noise, zero innovation
 					s.sensor = sensor;
 					s.height_m = b->sensorLocationOnRobot.z() - m.range * std::sin(m.pitch);
-					if (whiten(s)) out.push_back(s);
+					if (whiten(s))
+						out.push_back(s);
 					else
 						++rejected;
 				}
@@ -787,8 +796,8 @@ class EkfSlam::Impl
 		const Eigen::Vector3d lm = kf.landmark(idx);
 		const mrpt::poses::CPose2D world_T_landmark(lm[0], lm[1], lm[2]);
 		Eigen::Matrix3d C_world;
-		const mrpt::poses::CPose2D r = pose::robotPoseInWorld(
-			s.pose_in_landmark, s.C_R, world_T_landmark, s.sensor, &C_world);
+		const mrpt::poses::CPose2D r =
+			pose::robotPoseInWorld(s.pose_in_landmark, s.C_R, world_T_landmark, s.sensor, &C_world);
 		Eigen::Matrix3d J = Eigen::Matrix3d::Identity();  // d(robot)/d(landmark)
 		J(0, 2) = -(r.y() - lm[1]);
 		J(1, 2) = r.x() - lm[0];
@@ -806,8 +815,8 @@ class EkfSlam::Impl
 
 	template <std::size_t D>
 	StepStats step(
-		SlamKF<D>& kf, const mrpt::obs::CActionRobotMovement2D* odometry,
-		std::vector<Sighting> all, StepStats st)
+		SlamKF<D>& kf, const mrpt::obs::CActionRobotMovement2D* odometry, std::vector<Sighting> all,
+		StepStats st)
 	{
 		kf.used = 0;
 		kf.rejected = 0;
@@ -865,7 +874,8 @@ class EkfSlam::Impl
 			for (auto& s : all)
 			{
 				const bool fresh = !kf.id_to_idx.count(s.id) && seen[s.id]++ == 0;
-				if (fresh) passes.front().push_back(std::move(s));
+				if (fresh)
+					passes.front().push_back(std::move(s));
 				else
 					passes.push_back({std::move(s)});
 			}
@@ -911,14 +921,20 @@ EkfSlam::EkfSlam(
 		SlamKF<3> probe;  // MRPT's own loader, defaults as ours
 		auto& k = probe.KF_options;
 		k.loadFromConfigFile(*kf_cfg, kf_section);
-		m.kfo = {k.method, k.IKF_iterations, k.enable_profiler, k.use_analytic_transition_jacobian,
-			k.use_analytic_observation_jacobian, k.debug_verify_analytic_jacobians,
+		m.kfo = {
+			k.method,
+			k.IKF_iterations,
+			k.enable_profiler,
+			k.use_analytic_transition_jacobian,
+			k.use_analytic_observation_jacobian,
+			k.debug_verify_analytic_jacobians,
 			k.debug_verify_analytic_jacobians_threshold};
 	}
 	// With a prior map and no initial pose the robot waits for a pose fix
 	// (full landmarks; build() decides for good).
 	m.initialized = prior.landmarks.empty() || (initial && initial->initialized);
-	if (options.landmarks == SlamLandmarks::Full) m.build(m.k3);
+	if (options.landmarks == SlamLandmarks::Full)
+		m.build(m.k3);
 	else if (options.landmarks == SlamLandmarks::Point)
 		m.build(m.k2);
 	// Auto: decided by the first frame with sightings.
@@ -956,12 +972,13 @@ StepStats EkfSlam::step(
 		}
 		bool any_coded = false;
 		for (const auto& s : all) any_coded |= !s.point;
-		if (any_coded) m.build(m.k3);
+		if (any_coded)
+			m.build(m.k3);
 		else
 			m.build(m.k2);
 	}
 	if (m.k2)
-		for (auto& s : all) s.point = true;  // coded sightings feed range and bearing only
+		for (auto& s : all) s.point = true;	 // coded sightings feed range and bearing only
 	if (m.k3) return m.step(*m.k3, odometry, std::move(all), st);
 	return m.step(*m.k2, odometry, std::move(all), st);
 }
@@ -1036,7 +1053,10 @@ double EkfSlam::meanKalmanIterationMs() const
 	if (!impl_->created()) return 0;
 	return impl_->visit(
 		[](const auto& kf)
-		{ return 1e3 * const_cast<std::decay_t<decltype(kf)>&>(kf).getProfiler().getMeanTime("KF:complete_step"); });
+		{
+			return 1e3 * const_cast<std::decay_t<decltype(kf)>&>(kf).getProfiler().getMeanTime(
+							 "KF:complete_step");
+		});
 }
 
 std::size_t EkfSlam::kalmanIterations() const

@@ -30,18 +30,20 @@ GroundTruth GroundTruth::load(const std::string& path)
 			if (n != 4 && n != 6)
 				throw std::runtime_error(
 					path + ":" + std::to_string(lineno) + ": " + std::to_string(n) +
-					" columns; expected 4 (timestamp x y yaw) or 6 (MRPT path: x y z yaw pitch roll)");
+					" columns; expected 4 (timestamp x y yaw) or 6 (MRPT path: x y z yaw pitch "
+					"roll)");
 			columns = n;
 			gt.form_ = n == 4 ? Form::Timestamped : Form::MrptPath;
 		}
 		else if (n != columns)
 			throw std::runtime_error(
-				path + ":" + std::to_string(lineno) + ": " + std::to_string(n) + " columns, expected " +
-				std::to_string(columns) + " as in the first row");
+				path + ":" + std::to_string(lineno) + ": " + std::to_string(n) +
+				" columns, expected " + std::to_string(columns) + " as in the first row");
 		if (columns == 4)
 		{
 			if (!gt.times_.empty() && v[0] < gt.times_.back())
-				throw std::runtime_error(path + ":" + std::to_string(lineno) + ": timestamps not ascending");
+				throw std::runtime_error(
+					path + ":" + std::to_string(lineno) + ": timestamps not ascending");
 			gt.times_.push_back(v[0]);
 			gt.poses_.emplace_back(v[1], v[2], v[3]);
 		}
@@ -52,7 +54,8 @@ GroundTruth GroundTruth::load(const std::string& path)
 	return gt;
 }
 
-std::optional<mrpt::poses::CPose2D> GroundTruth::poseAt(long index, double t, double tol, long actions) const
+std::optional<mrpt::poses::CPose2D> GroundTruth::poseAt(
+	long index, double t, double tol, long actions) const
 {
 	if (form_ == Form::MrptPath)
 	{

@@ -66,7 +66,9 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 		for (const auto& r : rows)
 			if (r.estimate.initialized && r.truth)
 			{
-				if (a.empty()) m.truth_T_start = *r.truth + (CPose2D() - r.estimate.mean);  // truth_0 (+) estimate_0^-1
+				if (a.empty())
+					m.truth_T_start =
+						*r.truth + (CPose2D() - r.estimate.mean);  // truth_0 (+) estimate_0^-1
 				a.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
 				b.emplace_back(r.truth->x(), r.truth->y());
 			}
@@ -85,7 +87,8 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 			R.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(truth_T_frame.phi()).toRotationMatrix();
 			*cov = R * r.estimate.cov * R.transpose();
 		}
-		return Eigen::Vector3d(est.x() - r.truth->x(), est.y() - r.truth->y(),
+		return Eigen::Vector3d(
+			est.x() - r.truth->x(), est.y() - r.truth->y(),
 			mrpt::math::wrapToPi(est.phi() - r.truth->phi()));
 	};
 	double se = 0, syaw = 0, snees = 0, sanchored = 0;
@@ -133,7 +136,8 @@ std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg
 	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
 	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
 	if (!(sxy > 0) || !(syaw > 0))
-		throw std::invalid_argument("[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
+		throw std::invalid_argument(
+			"[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
 	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 	return e;
 }
@@ -151,8 +155,10 @@ void writeTextFiles(const LocalizeSummary& s, const std::string& dir)
 	std::ofstream path(dir + "/estimated_path.txt"), tum(dir + "/estimated_path.tum"),
 		cov(dir + "/covariances.txt");
 	if (!path || !tum || !cov) throw std::runtime_error(dir + ": cannot write the path files");
-	path << "# timestamp[UNIX s] x[m] y[m] yaw[rad]: robot pose in the map frame, one row per camera "
-			"frame from the first fix on (" << s.method << ")\n";
+	path << "# timestamp[UNIX s] x[m] y[m] yaw[rad]: robot pose in the map frame, one row per "
+			"camera "
+			"frame from the first fix on ("
+		 << s.method << ")\n";
 	tum << "# timestamp tx ty tz qx qy qz qw (TUM format; z = 0, rotation about z)\n";
 	cov << "# timestamp then the 3x3 covariance of (x, y, yaw) row by row [m^2, m rad, rad^2]\n";
 	for (const auto& r : s.rows)
@@ -161,24 +167,27 @@ void writeTextFiles(const LocalizeSummary& s, const std::string& dir)
 		const auto& p = r.estimate.mean;
 		const std::string t = num(r.timestamp, 6);
 		path << t << ' ' << num(p.x()) << ' ' << num(p.y()) << ' ' << num(p.phi()) << '\n';
-		tum << t << ' ' << num(p.x()) << ' ' << num(p.y()) << " 0 0 0 " << num(std::sin(p.phi() / 2), 9)
-			<< ' ' << num(std::cos(p.phi() / 2), 9) << '\n';
+		tum << t << ' ' << num(p.x()) << ' ' << num(p.y()) << " 0 0 0 "
+			<< num(std::sin(p.phi() / 2), 9) << ' ' << num(std::cos(p.phi() / 2), 9) << '\n';
 		cov << t;
 		for (int i = 0; i < 3; ++i)
-			for (int j = 0; j < 3; ++j) cov << ' ' << std::setprecision(9) << std::scientific << r.estimate.cov(i, j);
+			for (int j = 0; j < 3; ++j)
+				cov << ' ' << std::setprecision(9) << std::scientific << r.estimate.cov(i, j);
 		cov << std::defaultfloat << '\n';
 	}
 	if (!s.slam_map.empty())
 	{
 		LandmarkMap m;
 		std::ofstream mc(dir + "/map_covariances.txt");
-		mc << "# id then the 3x3 covariance of the landmark's (x, y, yaw) row by row [m^2, m rad, rad^2]\n";
+		mc << "# id then the 3x3 covariance of the landmark's (x, y, yaw) row by row [m^2, m rad, "
+			  "rad^2]\n";
 		for (const auto& l : s.slam_map)
 		{
 			m.landmarks.push_back(l.landmark);
 			mc << l.landmark.id;
 			for (int i = 0; i < 3; ++i)
-				for (int j = 0; j < 3; ++j) mc << ' ' << std::setprecision(9) << std::scientific << l.cov(i, j);
+				for (int j = 0; j < 3; ++j)
+					mc << ' ' << std::setprecision(9) << std::scientific << l.cov(i, j);
 			mc << std::defaultfloat << '\n';
 		}
 		m.save(dir + "/map.txt");
@@ -190,9 +199,8 @@ void writeTextFiles(const LocalizeSummary& s, const std::string& dir)
 void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::string& file)
 {
 	double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-	auto grow = [&](double x, double y) {
-		x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-	};
+	auto grow = [&](double x, double y)
+	{ x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y); };
 	for (const auto& l : map.landmarks) grow(l.x_m, l.y_m);
 	for (const auto& l : s.slam_map) grow(l.landmark.x_m, l.landmark.y_m);
 	for (const auto& r : s.rows)
@@ -208,17 +216,22 @@ void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::stri
 	const int H = std::clamp(static_cast<int>((y1 - y0) * scale), 100, 4000);
 	cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
 	auto px = [&](double x, double y) {
-		return cv::Point(static_cast<int>((x - x0) * scale), static_cast<int>(H - (y - y0) * scale));
+		return cv::Point(
+			static_cast<int>((x - x0) * scale), static_cast<int>(H - (y - y0) * scale));
 	};
 	for (int g = static_cast<int>(std::ceil(x0)); g <= x1; ++g)
 		cv::line(img, px(g, y0), px(g, y1), cv::Scalar(230, 230, 230));
 	for (int g = static_cast<int>(std::ceil(y0)); g <= y1; ++g)
 		cv::line(img, px(x0, g), px(x1, g), cv::Scalar(230, 230, 230));
-	auto drawLandmark = [&](const MapLandmark& l, const cv::Scalar& c) {
+	auto drawLandmark = [&](const MapLandmark& l, const cv::Scalar& c)
+	{
 		cv::circle(img, px(l.x_m, l.y_m), 4, c, cv::FILLED, cv::LINE_AA);
-		cv::line(img, px(l.x_m, l.y_m),
-			px(l.x_m + 0.25 * std::cos(l.yaw_rad), l.y_m + 0.25 * std::sin(l.yaw_rad)), c, 1, cv::LINE_AA);
-		cv::putText(img, std::to_string(l.id), px(l.x_m, l.y_m) + cv::Point(5, -5),
+		cv::line(
+			img, px(l.x_m, l.y_m),
+			px(l.x_m + 0.25 * std::cos(l.yaw_rad), l.y_m + 0.25 * std::sin(l.yaw_rad)), c, 1,
+			cv::LINE_AA);
+		cv::putText(
+			img, std::to_string(l.id), px(l.x_m, l.y_m) + cv::Point(5, -5),
 			cv::FONT_HERSHEY_SIMPLEX, 0.4, c, 1, cv::LINE_AA);
 	};
 	for (const auto& l : map.landmarks) drawLandmark(l, cv::Scalar(0, 0, 0));
@@ -244,9 +257,12 @@ void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::stri
 		const cv::Size axes(
 			std::max(1, static_cast<int>(k95 * std::sqrt(ev[1]) * scale)),
 			std::max(1, static_cast<int>(k95 * std::sqrt(ev[0]) * scale)));
-		cv::ellipse(img, px(e.mean.x(), e.mean.y()), axes, -ang, 0, 360, cv::Scalar(0, 0, 220), 1, cv::LINE_AA);
+		cv::ellipse(
+			img, px(e.mean.x(), e.mean.y()), axes, -ang, 0, 360, cv::Scalar(0, 0, 220), 1,
+			cv::LINE_AA);
 	}
-	cv::putText(img, s.method + ": estimate (blue), ground truth (green), 95% ellipses (red), 1 m grid",
+	cv::putText(
+		img, s.method + ": estimate (blue), ground truth (green), 95% ellipses (red), 1 m grid",
 		cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	if (!cv::imwrite(file, img)) throw std::runtime_error(file + ": cannot write");
 }
@@ -268,13 +284,15 @@ void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::str
 		const auto& r = s.rows[i];
 		if (prev && prev->estimate.initialized && r.estimate.initialized)
 		{
-			est->appendLine(prev->estimate.mean.x(), prev->estimate.mean.y(), 0.01, r.estimate.mean.x(),
+			est->appendLine(
+				prev->estimate.mean.x(), prev->estimate.mean.y(), 0.01, r.estimate.mean.x(),
 				r.estimate.mean.y(), 0.01);
 			have_est = true;
 		}
 		if (prev && prev->truth && r.truth)
 		{
-			gt->appendLine(prev->truth->x(), prev->truth->y(), 0.0, r.truth->x(), r.truth->y(), 0.0);
+			gt->appendLine(
+				prev->truth->x(), prev->truth->y(), 0.0, r.truth->x(), r.truth->y(), 0.0);
 			have_gt = true;
 		}
 		if (r.estimate.initialized && i % every == 0)
@@ -295,7 +313,8 @@ void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::str
 	auto lms = mrpt::opengl::CPointCloud::Create();
 	lms->setPointSize(8);
 	lms->setColor(0, 0, 0);
-	auto addLandmark = [&](const MapLandmark& l) {
+	auto addLandmark = [&](const MapLandmark& l)
+	{
 		lms->insertPoint(l.x_m, l.y_m, l.z_m);
 		auto t = mrpt::opengl::CText::Create(std::to_string(l.id));
 		t->setLocation(l.x_m, l.y_m, l.z_m + 0.1);
@@ -333,7 +352,8 @@ std::string summaryJson(const LocalizeSummary& s)
 		o << "  \"max_error_m\": " << num(m.max_error_m, 6) << ",\n";
 		o << "  \"yaw_rmse_deg\": " << num(m.yaw_rmse_deg, 4) << ",\n";
 		o << "  \"nees_mean\": " << num(m.nees_mean, 4) << ",\n";
-		o << "  \"nees_band_95\": [" << num(m.nees_band_low, 4) << ", " << num(m.nees_band_high, 4) << "],\n";
+		o << "  \"nees_band_95\": [" << num(m.nees_band_low, 4) << ", " << num(m.nees_band_high, 4)
+		  << "],\n";
 		// SLAM without a prior map: its frame is the robot's start; the
 		// errors above are after an SE(2) least-squares alignment.
 		// ate, max and yaw errors after an SE(2) least-squares alignment,
@@ -343,7 +363,8 @@ std::string summaryJson(const LocalizeSummary& s)
 		if (m.aligned)
 		{
 			o << "  \"alignment_truth_T_estimate\": [" << num(m.truth_T_estimate.x(), 6) << ", "
-			  << num(m.truth_T_estimate.y(), 6) << ", " << num(m.truth_T_estimate.phi(), 6) << "],\n";
+			  << num(m.truth_T_estimate.y(), 6) << ", " << num(m.truth_T_estimate.phi(), 6)
+			  << "],\n";
 			o << "  \"nees_frame\": \"anchored_at_true_first_pose\",\n";
 			o << "  \"ate_rmse_anchored_m\": " << num(m.ate_rmse_anchored_m, 6) << ",\n";
 		}
@@ -373,7 +394,8 @@ void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::s
 }
 
 LocalizeSummary runLocalization(
-	const LocalizeRequest& req, const std::function<void(double)>& progress, const StepObserver& on_step)
+	const LocalizeRequest& req, const std::function<void(double)>& progress,
+	const StepObserver& on_step)
 {
 	if (!std::ifstream(req.config_file).good())
 		throw std::runtime_error(req.config_file + ": cannot open config file");
@@ -382,12 +404,14 @@ LocalizeSummary runLocalization(
 	s.method = !req.method.empty() ? req.method : cfg.read_string("localize", "method", "ekf");
 	const bool slam = s.method == "ekf-slam";
 	LandmarkMap map;
-	if (!req.map_file.empty()) map = loadAnyMap(req.map_file);
+	if (!req.map_file.empty())
+		map = loadAnyMap(req.map_file);
 	else if (!slam)
 		throw std::invalid_argument("method '" + s.method + "' needs a landmark map (--map)");
 	if (!slam && map.landmarks.empty())
 		throw std::invalid_argument(
-			req.map_file + ": the map has no landmarks (method '" + s.method + "' needs at least one)");
+			req.map_file + ": the map has no landmarks (method '" + s.method +
+			"' needs at least one)");
 	std::optional<GroundTruth> gt;
 	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
 
@@ -425,7 +449,8 @@ LocalizeSummary runLocalization(
 		{
 			// A filter failure (non-finite or non-positive-definite state)
 			// names the rawlog entry that caused it.
-			throw std::runtime_error(req.rawlog + ": entry #" + std::to_string(step.entry) + " (step " +
+			throw std::runtime_error(
+				req.rawlog + ": entry #" + std::to_string(step.entry) + " (step " +
 				std::to_string(step.index) + "): " + mrpt::exception_to_str(e));
 		}
 		const auto t1 = std::chrono::steady_clock::now();
@@ -470,10 +495,12 @@ LocalizeSummary runLocalization(
 				if (t.id == l.landmark.id)
 				{
 					const auto p = s.metrics->truth_T_estimate +
-						mrpt::poses::CPoint2D(l.landmark.x_m, l.landmark.y_m);
+								   mrpt::poses::CPoint2D(l.landmark.x_m, l.landmark.y_m);
 					se += std::pow(p.x() - t.x_m, 2) + std::pow(p.y() - t.y_m, 2);
-					syaw += std::pow(mrpt::math::wrapToPi(
-						l.landmark.yaw_rad + s.metrics->truth_T_estimate.phi() - t.yaw_rad), 2);
+					syaw += std::pow(
+						mrpt::math::wrapToPi(
+							l.landmark.yaw_rad + s.metrics->truth_T_estimate.phi() - t.yaw_rad),
+						2);
 					++n;
 				}
 		s.metrics->landmarks_matched = n;

@@ -63,7 +63,8 @@ void ParticleFilterOptions::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(random_seed, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(no_odometry_std_xy_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(no_odometry_std_yaw_deg, double, c, s);
-	auto require = [&](bool ok, const char* key, const char* what) {
+	auto require = [&](bool ok, const char* key, const char* what)
+	{
 		if (!ok)
 			throw std::invalid_argument(
 				std::string("method 'pf': [") + s + "] " + key + " " + what);
@@ -80,8 +81,7 @@ void ParticleFilterOptions::loadFromConfigFile(
 	require(
 		inject_min_std_xy_m >= 0 && inject_min_std_yaw_deg >= 0, "inject_min_std_*",
 		"must be >= 0");
-	require(
-		converged_std_xy_m > 0 && converged_std_yaw_deg > 0, "converged_std_*", "must be > 0");
+	require(converged_std_xy_m > 0 && converged_std_yaw_deg > 0, "converged_std_*", "must be > 0");
 	require(
 		no_odometry_std_xy_m > 0 && no_odometry_std_yaw_deg > 0, "no_odometry_std_*",
 		"must be > 0");
@@ -171,13 +171,13 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(
 		mrpt::math::TPoint3D lo, hi;
 		m_map->boundingBox(lo, hi);
 		const double m = m_opts.init_margin_m;
-		m_pdf.resetUniform(lo.x - m, hi.x + m, lo.y - m, hi.y + m, -M_PI, M_PI, static_cast<int>(N));
+		m_pdf.resetUniform(
+			lo.x - m, hi.x + m, lo.y - m, hi.y + m, -M_PI, M_PI, static_cast<int>(N));
 	}
 }
 
 StepStats ParticleFilterLocalizer::step(
-	const mrpt::obs::CActionRobotMovement2D* odometry,
-	const mrpt::obs::CSensoryFrame& observations)
+	const mrpt::obs::CActionRobotMovement2D* odometry, const mrpt::obs::CSensoryFrame& observations)
 {
 	StepStats stats;
 
@@ -206,7 +206,8 @@ StepStats ParticleFilterLocalizer::step(
 		if (auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
 		{
 			coded.push_back(c.get());
-			for (const auto& s : c->sightings) (m_map->find(s.id) ? stats.used : stats.unknown_id)++;
+			for (const auto& s : c->sightings)
+				(m_map->find(s.id) ? stats.used : stats.unknown_id)++;
 			sf.insert(o);
 		}
 		else if (auto b = std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(o))
@@ -220,13 +221,15 @@ StepStats ParticleFilterLocalizer::step(
 	m_pf.executeOn(m_pdf, &actions, sf.size() ? &sf : nullptr, &m_stats);
 
 	// Does the best particle explain the frame's coded sightings?
-	auto gatedOut = [&](const mrpt::math::TPose2D& pose) {
+	auto gatedOut = [&](const mrpt::math::TPose2D& pose)
+	{
 		int known = 0, out = 0;
 		const double c = std::cos(pose.phi), s = std::sin(pose.phi);
 		for (const auto* o : coded)
 		{
 			double cx = 0, cy = 0, cc = 1, cs = 0;
-			if (!CCodedLandmarksMap::cameraInWorld(pose.x, pose.y, c, s, o->cameraPose, cx, cy, cc, cs))
+			if (!CCodedLandmarksMap::cameraInWorld(
+					pose.x, pose.y, c, s, o->cameraPose, cx, cy, cc, cs))
 				continue;
 			for (const auto& sg : o->sightings)
 			{
@@ -249,7 +252,7 @@ StepStats ParticleFilterLocalizer::step(
 		if (known > 0) m_unexplained = (out == known) ? m_unexplained + 1 : 0;
 
 		const bool collapsed = m_opts.inject_ess_threshold > 0 &&
-			m_stats.ESS_beforeResample < m_opts.inject_ess_threshold;
+							   m_stats.ESS_beforeResample < m_opts.inject_ess_threshold;
 		// Before the first convergence one unexplained frame suffices: with
 		// the uniform mixture, a spread-out cloud far from every fix scores
 		// the same floor everywhere and its ESS says nothing.
@@ -270,7 +273,8 @@ StepStats ParticleFilterLocalizer::step(
 		const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(e.cov.topLeftCorner<2, 2>());
 		const double std_xy = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
 		const double std_yaw = std::sqrt(std::max(0.0, e.cov(2, 2)));
-		m_converged = std_xy < m_opts.converged_std_xy_m && std_yaw < m_opts.converged_std_yaw_deg * kDeg;
+		m_converged =
+			std_xy < m_opts.converged_std_xy_m && std_yaw < m_opts.converged_std_yaw_deg * kDeg;
 	}
 	if (m_converged && !coded.empty())
 	{
@@ -285,11 +289,11 @@ StepStats ParticleFilterLocalizer::step(
 bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& observations)
 {
 	std::vector<Fix> fixes;
-	const Eigen::Matrix3d floor = Eigen::Vector3d(
-									  std::pow(m_opts.inject_min_std_xy_m, 2),
-									  std::pow(m_opts.inject_min_std_xy_m, 2),
-									  std::pow(m_opts.inject_min_std_yaw_deg * kDeg, 2))
-									  .asDiagonal();
+	const Eigen::Matrix3d floor =
+		Eigen::Vector3d(
+			std::pow(m_opts.inject_min_std_xy_m, 2), std::pow(m_opts.inject_min_std_xy_m, 2),
+			std::pow(m_opts.inject_min_std_yaw_deg * kDeg, 2))
+			.asDiagonal();
 	for (const auto& o : observations)
 	{
 		const auto* c = dynamic_cast<const CObservationCodedLandmarks*>(o.get());
@@ -305,7 +309,8 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 				robot_T_camera, &C);
 			C = 0.5 * (C + C.transpose()) + floor;
 			if (!C.allFinite() || !(C.determinant() > 0)) continue;
-			fixes.push_back({Eigen::Vector3d(world_T_robot.x(), world_T_robot.y(), world_T_robot.phi()), C});
+			fixes.push_back(
+				{Eigen::Vector3d(world_T_robot.x(), world_T_robot.y(), world_T_robot.phi()), C});
 		}
 	}
 	auto& parts = m_pdf.m_particles;
@@ -315,7 +320,8 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 	// sample is weighted by this frame's likelihood at it, with the prior
 	// weight of the current best particle: the injected samples compete
 	// with the survivors on the same evidence.
-	auto frameLogLik = [&](const mrpt::math::TPose2D& p) {
+	auto frameLogLik = [&](const mrpt::math::TPose2D& p)
+	{
 		const mrpt::poses::CPose3D x{mrpt::poses::CPose2D(p)};
 		double ll = 0;
 		for (const auto& o : observations) ll += m_map->computeObservationLikelihood(*o, x);
@@ -326,7 +332,8 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 	const double prior_best = best->log_w - frameLogLik(best->d);
 	const size_t n = std::min(
 		parts.size(),
-		std::max<size_t>(1, static_cast<size_t>(std::lround(m_opts.inject_fraction * double(parts.size())))));
+		std::max<size_t>(
+			1, static_cast<size_t>(std::lround(m_opts.inject_fraction * double(parts.size())))));
 	std::vector<size_t> order(parts.size());
 	std::iota(order.begin(), order.end(), size_t(0));
 	std::nth_element(
@@ -354,15 +361,18 @@ void ParticleFilterLocalizer::checkFinite(const PoseEstimate& e) const
 	for (std::size_t i = 0; i < parts.size(); ++i)
 	{
 		const auto& p = parts[i];
-		if (!std::isfinite(p.d.x) || !std::isfinite(p.d.y) || !std::isfinite(p.d.phi) || std::isnan(p.log_w))
-			throw std::runtime_error("pf: particle #" + std::to_string(i) + " of " +
-				std::to_string(parts.size()) + " became non-finite (pose " + p.d.asString() +
-				", log-weight " + std::to_string(p.log_w) + ")");
+		if (!std::isfinite(p.d.x) || !std::isfinite(p.d.y) || !std::isfinite(p.d.phi) ||
+			std::isnan(p.log_w))
+			throw std::runtime_error(
+				"pf: particle #" + std::to_string(i) + " of " + std::to_string(parts.size()) +
+				" became non-finite (pose " + p.d.asString() + ", log-weight " +
+				std::to_string(p.log_w) + ")");
 	}
 	if (!std::isfinite(e.mean.x()) || !std::isfinite(e.mean.y()) || !std::isfinite(e.mean.phi()))
 		throw std::runtime_error("pf: the estimate became non-finite: " + e.mean.asString());
 	if (!e.cov.allFinite())
-		throw std::runtime_error("pf: the estimate's covariance became non-finite (particle spread overflows)");
+		throw std::runtime_error(
+			"pf: the estimate's covariance became non-finite (particle spread overflows)");
 }
 
 PoseEstimate ParticleFilterLocalizer::estimate() const

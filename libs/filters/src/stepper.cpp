@@ -24,13 +24,18 @@ namespace codemark::filters
 using mrpt::obs::CObservation;
 using mrpt::poses::CPose2D;
 
-void StepperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+void StepperOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	// Read by name here: MRPT 2.5.8 does not export the enum's TEnumType filler.
-	const std::string model = c.read_string(s, "modelSelection",
-		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "mmGaussian" : "mmThrun");
-	if (model == "mmGaussian") motion.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
-	else if (model == "mmThrun") motion.modelSelection = mrpt::obs::CActionRobotMovement2D::mmThrun;
+	const std::string model = c.read_string(
+		s, "modelSelection",
+		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "mmGaussian"
+																			   : "mmThrun");
+	if (model == "mmGaussian")
+		motion.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
+	else if (model == "mmThrun")
+		motion.modelSelection = mrpt::obs::CActionRobotMovement2D::mmThrun;
 	else
 		throw std::invalid_argument(
 			"[" + s + "] modelSelection: '" + model + "' (expected mmGaussian or mmThrun)");
@@ -38,10 +43,12 @@ void StepperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	motion.gaussianModel.a2 = c.read_float(s, "gaussianModel.a2", motion.gaussianModel.a2);
 	motion.gaussianModel.a3 = c.read_float(s, "gaussianModel.a3", motion.gaussianModel.a3);
 	motion.gaussianModel.a4 = c.read_float(s, "gaussianModel.a4", motion.gaussianModel.a4);
-	motion.gaussianModel.minStdXY = c.read_float(s, "gaussianModel.minStdXY", motion.gaussianModel.minStdXY);
+	motion.gaussianModel.minStdXY =
+		c.read_float(s, "gaussianModel.minStdXY", motion.gaussianModel.minStdXY);
 	motion.gaussianModel.minStdPHI =
 		c.read_float(s, "gaussianModel.minStdPHI", motion.gaussianModel.minStdPHI);
-	motion.thrunModel.alfa1_rot_rot = c.read_float(s, "thrunModel.alfa1_rot_rot", motion.thrunModel.alfa1_rot_rot);
+	motion.thrunModel.alfa1_rot_rot =
+		c.read_float(s, "thrunModel.alfa1_rot_rot", motion.thrunModel.alfa1_rot_rot);
 	motion.thrunModel.alfa2_rot_trans =
 		c.read_float(s, "thrunModel.alfa2_rot_trans", motion.thrunModel.alfa2_rot_trans);
 	motion.thrunModel.alfa3_trans_trans =
@@ -60,8 +67,10 @@ void StepperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 
 void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "modelSelection",
-		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "mmGaussian" : "mmThrun",
+	c.write(
+		s, "modelSelection",
+		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "mmGaussian"
+																			   : "mmThrun",
 		-1, -1);
 	c.write(s, "gaussianModel.a1", motion.gaussianModel.a1, -1, -1);
 	c.write(s, "gaussianModel.a2", motion.gaussianModel.a2, -1, -1);
@@ -88,8 +97,8 @@ namespace
 bool isCameraFrameObservation(const CObservation& o)
 {
 	return dynamic_cast<const mrpt::obs::CObservationImage*>(&o) ||
-		dynamic_cast<const CObservationCodedLandmarks*>(&o) ||
-		dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&o);
+		   dynamic_cast<const CObservationCodedLandmarks*>(&o) ||
+		   dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&o);
 }
 
 // A camera frame waiting for its odometry (observations-only format).
@@ -110,7 +119,7 @@ struct RawlogStepper::Impl
 	long total_bytes = 0;
 	long entries = 0;
 	long steps = 0;
-	long actions_read = 0;  // CActionCollection entries so far
+	long actions_read = 0;	// CActionCollection entries so far
 	bool eof = false;
 	bool actions_observations = false;
 
@@ -118,9 +127,9 @@ struct RawlogStepper::Impl
 	std::optional<mrpt::poses::CPosePDFGaussian> acc;
 
 	// Observations-only.
-	std::optional<Frame> open;  // frame still collecting observations
-	std::deque<Frame> pending;  // closed frames waiting for odometry
-	std::optional<std::pair<double, CPose2D>> last_odo;  // latest reading (t, pose)
+	std::optional<Frame> open;	// frame still collecting observations
+	std::deque<Frame> pending;	// closed frames waiting for odometry
+	std::optional<std::pair<double, CPose2D>> last_odo;	 // latest reading (t, pose)
 	std::optional<std::pair<double, CPose2D>> seg_start;  // start (t, pose) of the current segment
 	bool had_frame_with_odometry = false;
 
@@ -144,8 +153,10 @@ struct RawlogStepper::Impl
 		catch (const std::exception& e)
 		{
 			throw std::runtime_error(
-				where(entries) + " cannot be read (truncated or corrupt file, or a class whose plugin is "
-				"not loaded): " + mrpt::exception_to_str(e));
+				where(entries) +
+				" cannot be read (truncated or corrupt file, or a class whose plugin is "
+				"not loaded): " +
+				mrpt::exception_to_str(e));
 		}
 		const long entry = entries++;
 		if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj))
@@ -164,7 +175,8 @@ struct RawlogStepper::Impl
 		else
 			throw std::runtime_error(
 				where(entry) + " holds a '" + (obj ? obj->GetRuntimeClass()->className : "null") +
-				"', which is not a rawlog entry (CSensoryFrame, CActionCollection or CObservation)");
+				"', which is not a rawlog entry (CSensoryFrame, CActionCollection or "
+				"CObservation)");
 		return nullptr;
 	}
 
@@ -176,15 +188,20 @@ struct RawlogStepper::Impl
 			if (!mv || !mv->poseChange) continue;
 			mrpt::poses::CPosePDFGaussian g;
 			g.copyFrom(*mv->poseChange);
-			if (!std::isfinite(g.mean.x()) || !std::isfinite(g.mean.y()) || !std::isfinite(g.mean.phi()))
-				throw std::runtime_error(where(entry) + ": odometry increment (CActionRobotMovement2D) is not finite: " +
+			if (!std::isfinite(g.mean.x()) || !std::isfinite(g.mean.y()) ||
+				!std::isfinite(g.mean.phi()))
+				throw std::runtime_error(
+					where(entry) + ": odometry increment (CActionRobotMovement2D) is not finite: " +
 					g.mean.asString());
 			if (!g.cov.asEigen().allFinite())
 				throw std::runtime_error(
-					where(entry) + ": odometry increment (CActionRobotMovement2D) has a non-finite covariance");
-			if (!acc) acc = g;
-			else *acc += g;
-			break;  // one movement per collection
+					where(entry) +
+					": odometry increment (CActionRobotMovement2D) has a non-finite covariance");
+			if (!acc)
+				acc = g;
+			else
+				*acc += g;
+			break;	// one movement per collection
 		}
 	}
 
@@ -208,7 +225,7 @@ struct RawlogStepper::Impl
 				if (f.obs.empty()) f.stamp = o->timestamp;
 				f.obs.push_back(o);
 			}
-		if (f.obs.empty()) return;  // no camera frame: its motion carries over
+		if (f.obs.empty()) return;	// no camera frame: its motion carries over
 		mrpt::obs::CActionRobotMovement2D::Ptr odo;
 		if (acc) odo = actionFromPdf(*acc);
 		acc.reset();
@@ -227,8 +244,10 @@ struct RawlogStepper::Impl
 		mrpt::poses::CPosePDFGaussian g;
 		g.copyFrom(*act.poseChange);
 		g.cov *= std::clamp(fraction, 0.0, 1.0);
-		if (!acc) acc = g;
-		else *acc += g;
+		if (!acc)
+			acc = g;
+		else
+			*acc += g;
 	}
 
 	void onObservation(const CObservation::Ptr& o, long entry)
@@ -237,8 +256,9 @@ struct RawlogStepper::Impl
 		{
 			if (!std::isfinite(odo->odometry.x()) || !std::isfinite(odo->odometry.y()) ||
 				!std::isfinite(odo->odometry.phi()))
-				throw std::runtime_error(where(entry) + ": odometry reading (CObservationOdometry '" +
-					odo->sensorLabel + "') is not finite: " + odo->odometry.asString());
+				throw std::runtime_error(
+					where(entry) + ": odometry reading (CObservationOdometry '" + odo->sensorLabel +
+					"') is not finite: " + odo->odometry.asString());
 			closeOpen();
 			const double t = mrpt::Clock::toDouble(odo->timestamp);
 			const double interval = last_odo ? t - last_odo->first : 0.0;
@@ -249,18 +269,21 @@ struct RawlogStepper::Impl
 				const double tf = mrpt::Clock::toDouble(pending.front().stamp);
 				if (!last_odo)
 				{
-					emit(pending.front(), nullptr);  // before any odometry
+					emit(pending.front(), nullptr);	 // before any odometry
 					pending.pop_front();
 					continue;
 				}
-				const CPose2D p = interpolatePose(last_odo->first, last_odo->second, t, odo->odometry, tf);
-				addSegment(seg_start->second, p, interval > 0 ? (tf - seg_start->first) / interval : 1.0);
+				const CPose2D p =
+					interpolatePose(last_odo->first, last_odo->second, t, odo->odometry, tf);
+				addSegment(
+					seg_start->second, p, interval > 0 ? (tf - seg_start->first) / interval : 1.0);
 				seg_start = {tf, p};
 				emitAccumulated(pending.front());
 				pending.pop_front();
 			}
 			if (last_odo)
-				addSegment(seg_start->second, odo->odometry,
+				addSegment(
+					seg_start->second, odo->odometry,
 					interval > 0 ? (t - seg_start->first) / interval : 1.0);
 			last_odo = {t, odo->odometry};
 			seg_start = last_odo;
@@ -269,10 +292,11 @@ struct RawlogStepper::Impl
 		if (!isCameraFrameObservation(*o)) return;
 		// A frame: consecutive camera observations with one timestamp, one per
 		// sensor label (so that rawlogs without timestamps still split).
-		if (open &&
-			(open->stamp != o->timestamp ||
-				std::any_of(open->obs.begin(), open->obs.end(),
-					[&](const CObservation::Ptr& x) { return x->sensorLabel == o->sensorLabel; })))
+		if (open && (open->stamp != o->timestamp || std::any_of(
+														open->obs.begin(), open->obs.end(),
+														[&](const CObservation::Ptr& x) {
+															return x->sensorLabel == o->sensorLabel;
+														})))
 			closeOpen();
 		if (!open)
 		{
@@ -310,8 +334,10 @@ struct RawlogStepper::Impl
 		{
 			// After the last reading: no later one to interpolate with; the
 			// last reading is the best known odometry (no extrapolation).
-			if (last_odo) emitAccumulated(pending.front());
-			else emit(pending.front(), nullptr);
+			if (last_odo)
+				emitAccumulated(pending.front());
+			else
+				emit(pending.front(), nullptr);
 			pending.pop_front();
 		}
 	}
@@ -325,14 +351,15 @@ struct RawlogStepper::Impl
 			for (std::size_t i = 0; i < c->sightings.size(); ++i)
 			{
 				const auto& t = c->sightings[i];
-				const char* bad = !t.L.allFinite() ? "L"
-					: !t.C_L.allFinite()           ? "C_L"
-					: !t.pose_in_landmark.allFinite() ? "pose_in_landmark"
-					: !t.C_R.allFinite()           ? "C_R"
-												   : nullptr;
+				const char* bad = !t.L.allFinite()					? "L"
+								  : !t.C_L.allFinite()				? "C_L"
+								  : !t.pose_in_landmark.allFinite() ? "pose_in_landmark"
+								  : !t.C_R.allFinite()				? "C_R"
+																	: nullptr;
 				if (bad)
-					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): sighting #" +
-						std::to_string(i) + " (ID " + std::to_string(t.id) + ") has a non-finite " + bad);
+					throw std::runtime_error(
+						where(entry) + " (" + o.sensorLabel + "): sighting #" + std::to_string(i) +
+						" (ID " + std::to_string(t.id) + ") has a non-finite " + bad);
 			}
 		}
 		else if (const auto* b = dynamic_cast<const mrpt::obs::CObservationBearingRange*>(&o))
@@ -340,11 +367,13 @@ struct RawlogStepper::Impl
 			for (std::size_t i = 0; i < b->sensedData.size(); ++i)
 			{
 				const auto& m = b->sensedData[i];
-				const bool ok = std::isfinite(m.range) && std::isfinite(m.yaw) && std::isfinite(m.pitch) &&
-					(!b->validCovariances || m.covariance.asEigen().allFinite());
+				const bool ok = std::isfinite(m.range) && std::isfinite(m.yaw) &&
+								std::isfinite(m.pitch) &&
+								(!b->validCovariances || m.covariance.asEigen().allFinite());
 				if (!ok)
-					throw std::runtime_error(where(entry) + " (" + o.sensorLabel + "): reading #" +
-						std::to_string(i) + " (landmark ID " + std::to_string(m.landmarkID) +
+					throw std::runtime_error(
+						where(entry) + " (" + o.sensorLabel + "): reading #" + std::to_string(i) +
+						" (landmark ID " + std::to_string(m.landmarkID) +
 						") has a non-finite range, yaw, pitch or covariance");
 			}
 		}
@@ -357,12 +386,14 @@ struct RawlogStepper::Impl
 		s.entry = f.entry;
 		s.actions = actions_observations ? actions_read : -1;
 		s.has_timestamp = f.stamp != INVALID_TIMESTAMP;
-		s.timestamp = s.has_timestamp ? mrpt::Clock::toDouble(f.stamp) : static_cast<double>(s.index);
+		s.timestamp =
+			s.has_timestamp ? mrpt::Clock::toDouble(f.stamp) : static_cast<double>(s.index);
 		s.odometry = odo;
 		// Labels that already have a landmark observation in this frame.
 		std::vector<std::string> annotated;
 		for (const auto& o : f.obs)
-			if (dynamic_cast<const CObservationCodedLandmarks*>(o.get())) annotated.push_back(o->sensorLabel);
+			if (dynamic_cast<const CObservationCodedLandmarks*>(o.get()))
+				annotated.push_back(o->sensorLabel);
 		for (const auto& o : f.obs)
 		{
 			checkFinite(*o, f.entry);
@@ -370,7 +401,8 @@ struct RawlogStepper::Impl
 			{
 				if (!opt.detect_images) continue;
 				const std::string want = img->sensorLabel + "_LANDMARKS";
-				if (std::find(annotated.begin(), annotated.end(), want) != annotated.end()) continue;
+				if (std::find(annotated.begin(), annotated.end(), want) != annotated.end())
+					continue;
 				try
 				{
 					s.observations.insert(pipeline::observeImage(*img, pipe));
@@ -378,7 +410,8 @@ struct RawlogStepper::Impl
 				catch (const std::exception& e)
 				{
 					throw std::runtime_error(
-						where(f.entry) + " (" + img->sensorLabel + "): " + mrpt::exception_to_str(e));
+						where(f.entry) + " (" + img->sensorLabel +
+						"): " + mrpt::exception_to_str(e));
 				}
 				++s.images_detected;
 			}

@@ -36,8 +36,9 @@ mrpt::img::TCamera paperCamera()
 
 void validateCamera(const mrpt::img::TCamera& c, const std::string& path)
 {
-	const bool finite = std::isfinite(c.fx()) && std::isfinite(c.fy()) &&
-		std::isfinite(c.cx()) && std::isfinite(c.cy()) &&
+	const bool finite =
+		std::isfinite(c.fx()) && std::isfinite(c.fy()) && std::isfinite(c.cx()) &&
+		std::isfinite(c.cy()) &&
 		std::all_of(c.dist.begin(), c.dist.end(), [](double d) { return std::isfinite(d); });
 	if (!finite) throw std::runtime_error(path + ": camera parameters must be finite numbers");
 	if (c.ncols == 0 || c.nrows == 0)
@@ -51,7 +52,8 @@ void validateCamera(const mrpt::img::TCamera& c, const std::string& path)
 
 void addWarning(std::vector<std::string>* warnings, const std::string& w)
 {
-	if (warnings) warnings->push_back(w);
+	if (warnings)
+		warnings->push_back(w);
 	else
 		std::cerr << "warning: " << w << "\n";
 }
@@ -63,8 +65,7 @@ bool startsWithOpenCvYaml(const std::string& path)
 	std::getline(f, first);
 	std::stringstream all;
 	all << f.rdbuf();
-	return first.rfind("%YAML:", 0) == 0 ||
-		all.str().find("!!opencv-matrix") != std::string::npos;
+	return first.rfind("%YAML:", 0) == 0 || all.str().find("!!opencv-matrix") != std::string::npos;
 }
 
 mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
@@ -81,7 +82,8 @@ mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 	if (!fs.isOpened()) throw std::runtime_error(path + ": cannot parse OpenCV YAML");
 	// OpenCV allocates rows x cols as the file says before reading the data
 	// (a damaged 'rows' asked it for 48 GB in fuzzing): check the sizes first.
-	auto dims = [&](const char* key, int max_total) {
+	auto dims = [&](const char* key, int max_total)
+	{
 		const cv::FileNode n = fs[key];
 		if (n.empty() || n.isNone()) return 0;
 		if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt())
@@ -152,7 +154,8 @@ std::string capturingStderr(F&& f)
 	}
 	dup2(fileno(tmp), 2);
 	std::string captured;
-	auto restore = [&]() {
+	auto restore = [&]()
+	{
 		std::fflush(stderr);
 		dup2(saved, 2);
 		close(saved);
@@ -175,10 +178,12 @@ std::string capturingStderr(F&& f)
 }
 
 /** Every scalar of a YAML number field as text is a finite number. */
-void requireYamlNumbers(const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
+void requireYamlNumbers(
+	const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
 {
 	std::vector<std::string> values;
-	auto text = [&](const auto& scalar) {
+	auto text = [&](const auto& scalar)
+	{
 		try
 		{
 			values.push_back(scalar.template as<std::string>());
@@ -201,7 +206,8 @@ void requireYamlNumbers(const mrpt::containers::yaml& node, const std::string& w
 		throw std::runtime_error(path + ": '" + what + "' must be a number or a list of numbers");
 	for (const auto& v : values)
 		if (!parseFiniteNumber(v))
-			throw std::runtime_error(path + ": '" + what + "' holds '" + v + "', not a finite number");
+			throw std::runtime_error(
+				path + ": '" + what + "' holds '" + v + "', not a finite number");
 }
 
 /** Refuses what no camera YAML holds but makes libfyaml (0.8, Debian
@@ -213,7 +219,7 @@ void requirePlainYamlText(const std::string& path)
 	std::ifstream in(path, std::ios::binary);
 	const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 	int line = 1;
-	bool line_start = true;  // YAML breaks lines at '\n', '\r' and "\r\n"
+	bool line_start = true;	 // YAML breaks lines at '\n', '\r' and "\r\n"
 	for (std::size_t i = 0; i < text.size(); ++i)
 	{
 		const auto u = static_cast<unsigned char>(text[i]);
@@ -269,7 +275,8 @@ mrpt::img::TCamera loadRosYaml(const std::string& path)
 		throw std::runtime_error(path + ": 'camera_matrix.data' must hold 9 numbers");
 	if (y.has("distortion_coefficients") && y["distortion_coefficients"].isMap() &&
 		y["distortion_coefficients"].has("data"))
-		requireYamlNumbers(y["distortion_coefficients"]["data"], "distortion_coefficients.data", path);
+		requireYamlNumbers(
+			y["distortion_coefficients"]["data"], "distortion_coefficients.data", path);
 	if (!y.has("camera_name")) y["camera_name"] = std::string("camera");
 	if (!y.has("distortion_coefficients"))
 	{
@@ -301,10 +308,10 @@ mrpt::img::TCamera loadIni(
 			digits.begin(), digits.end(), [](char ch) { return ch >= '1' && ch <= '9'; });
 		if (nonzero)
 			addWarning(
-				warnings,
-				path + ": [" + section + "] has non-zero 'dist' but no 'distortion_model'; "
-				"MRPT ignores the distortion in that case, and so does codemark. "
-				"Add 'distortion_model = plumb_bob' to use it.");
+				warnings, path + ": [" + section +
+							  "] has non-zero 'dist' but no 'distortion_model'; "
+							  "MRPT ignores the distortion in that case, and so does codemark. "
+							  "Add 'distortion_model = plumb_bob' to use it.");
 	}
 	// MRPT reads "8o0" as 8 and "abc" as 0: check the numbers first.
 	requireIniNumbers(cfg, section, {"cx", "cy", "fx", "fy", "focal_length"}, false, false, path);
@@ -332,9 +339,9 @@ std::string lowerExtension(const std::string& path)
 	const auto dot = path.find_last_of('.');
 	if (dot == std::string::npos) return {};
 	std::string ext = path.substr(dot + 1);
-	std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) {
-		return static_cast<char>(std::tolower(ch));
-	});
+	std::transform(
+		ext.begin(), ext.end(), ext.begin(),
+		[](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
 	return ext;
 }
 
@@ -437,7 +444,8 @@ Eigen::Vector2d CameraModel::undistortToNormalized(const Eigen::Vector2d& raw) c
 	}
 	for (int it = 0; it < 5; ++it)
 	{
-		const auto f = [&](const Eigen::Vector2d& q) {
+		const auto f = [&](const Eigen::Vector2d& q)
+		{
 			const Eigen::Vector2d px = distortNormalized(q);
 			return Eigen::Vector2d((px.x() - cx()) / fx(), (px.y() - cy()) / fy());
 		};

@@ -14,8 +14,7 @@ constexpr int kBitOfCell[3][3] = {{7, 6, 5}, {4, -1, 3}, {2, 1, 0}};
 CodeCells encodeId(int id)
 {
 	if (id < 0 || id >= kNumIds)
-		throw std::out_of_range(
-			"landmark ID " + std::to_string(id) + " is outside 0..255");
+		throw std::out_of_range("landmark ID " + std::to_string(id) + " is outside 0..255");
 	CodeCells cells{};
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)

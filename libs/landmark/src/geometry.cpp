@@ -24,14 +24,18 @@ LandmarkGeometry LandmarkGeometry::scaledBy(double scale) const
 	return g;
 }
 
-LandmarkGeometry LandmarkGeometry::scaled(double scale) { return LandmarkGeometry().scaledBy(scale); }
+LandmarkGeometry LandmarkGeometry::scaled(double scale)
+{
+	return LandmarkGeometry().scaledBy(scale);
+}
 
 std::array<Eigen::Vector3d, 4> LandmarkGeometry::referencePoints() const
 {
 	const double h = innerHalf();
 	// As seen from the front: right is +Y_L, up is +Z_L.
-	return {faceToLandmark(-h, +h), faceToLandmark(+h, +h),
-			faceToLandmark(+h, -h), faceToLandmark(-h, -h)};
+	return {
+		faceToLandmark(-h, +h), faceToLandmark(+h, +h), faceToLandmark(+h, -h),
+		faceToLandmark(-h, -h)};
 }
 
 Eigen::Vector2d LandmarkGeometry::cellCentreFace(int row, int col) const
@@ -44,15 +48,14 @@ Eigen::Vector2d LandmarkGeometry::cellCentreFace(int row, int col) const
 void LandmarkGeometry::validate() const
 {
 	const bool ok = std::isfinite(outer_size_m) && std::isfinite(inner_size_m) &&
-		std::isfinite(cell_size_m) && std::isfinite(margin_m) &&
-		cell_size_m > 0 && 3 * cell_size_m < inner_size_m &&
-		inner_size_m < outer_size_m && margin_m >= 0;
+					std::isfinite(cell_size_m) && std::isfinite(margin_m) && cell_size_m > 0 &&
+					3 * cell_size_m < inner_size_m && inner_size_m < outer_size_m && margin_m >= 0;
 	if (!ok)
 	{
 		std::ostringstream s;
 		s << "invalid landmark geometry: need 0 < 3*cell_size_m (" << 3 * cell_size_m
-		  << ") < inner_size_m (" << inner_size_m << ") < outer_size_m ("
-		  << outer_size_m << ") and margin_m (" << margin_m << ") >= 0";
+		  << ") < inner_size_m (" << inner_size_m << ") < outer_size_m (" << outer_size_m
+		  << ") and margin_m (" << margin_m << ") >= 0";
 		throw std::invalid_argument(s.str());
 	}
 }
@@ -74,7 +77,9 @@ void LandmarkGeometry::saveToConfigFile(
 	mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "outer_size_m", outer_size_m, -1, -1, "outer edge of the black frame [m]");
-	c.write(s, "inner_size_m", inner_size_m, -1, -1, "inner edge of the frame, the reference square [m]");
+	c.write(
+		s, "inner_size_m", inner_size_m, -1, -1,
+		"inner edge of the frame, the reference square [m]");
 	c.write(s, "cell_size_m", cell_size_m, -1, -1, "one of the 3x3 code cells [m]");
 	c.write(s, "margin_m", margin_m, -1, -1, "minimum white margin around the frame [m]");
 }

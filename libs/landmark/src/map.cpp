@@ -17,9 +17,7 @@ mrpt::poses::CPose3D MapLandmark::world_T_landmark() const
 }
 
 MapFileError::MapFileError(const std::string& file, int line, const std::string& what)
-	: std::runtime_error(file + ":" + std::to_string(line) + ": " + what),
-	  file_(file),
-	  line_(line)
+	: std::runtime_error(file + ":" + std::to_string(line) + ": " + what), file_(file), line_(line)
 {
 }
 
@@ -33,15 +31,15 @@ const MapLandmark* LandmarkMap::find(int id) const
 namespace
 {
 // Parses one numeric field strictly: the whole token must be a finite number.
-double parseNumber(
-	const std::string& tok, const char* field, const std::string& name, int line)
+double parseNumber(const std::string& tok, const char* field, const std::string& name, int line)
 {
 	if (const auto v = parseFiniteNumber(tok)) return *v;
 	const bool number = std::isnan(std::strtod(tok.c_str(), nullptr)) ||
-		std::isinf(std::strtod(tok.c_str(), nullptr));
+						std::isinf(std::strtod(tok.c_str(), nullptr));
 	throw MapFileError(
 		name, line,
-		std::string("field '") + field + (number ? "' is not finite: '" : "' is not a number: '") + tok + "'");
+		std::string("field '") + field + (number ? "' is not finite: '" : "' is not a number: '") +
+			tok + "'");
 }
 }  // namespace
 
@@ -70,8 +68,7 @@ LandmarkMap LandmarkMap::parse(std::istream& in, const std::string& name)
 			v[i] = parseNumber(tok[i], kFields[i], name, line);
 		if (v[0] != std::floor(v[0]) || v[0] < 0 || v[0] > 255)
 			throw MapFileError(name, line, "ID '" + tok[0] + "' is not an integer in 0..255");
-		if (v[5] <= 0)
-			throw MapFileError(name, line, "scale must be > 0, got '" + tok[5] + "'");
+		if (v[5] <= 0) throw MapFileError(name, line, "scale must be > 0, got '" + tok[5] + "'");
 		MapLandmark l;
 		l.id = static_cast<int>(v[0]);
 		l.x_m = v[1];

@@ -54,11 +54,13 @@ std::string trim(const std::string& s)
 
 bool sameName(const std::string& a, const std::string& b)
 {
-	return a.size() == b.size() &&
-		std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
-			return std::tolower(static_cast<unsigned char>(x)) ==
-				std::tolower(static_cast<unsigned char>(y));
-		});
+	return a.size() == b.size() && std::equal(
+									   a.begin(), a.end(), b.begin(),
+									   [](char x, char y)
+									   {
+										   return std::tolower(static_cast<unsigned char>(x)) ==
+												  std::tolower(static_cast<unsigned char>(y));
+									   });
 }
 }  // namespace
 
@@ -137,7 +139,8 @@ void requireIniNumbers(
 		std::string v = raw;
 		if (const auto c = v.find_first_of(";#"); c != std::string::npos) v.erase(c);
 		v = trim(v);
-		if (vector && v.size() >= 2 && v.front() == '[' && v.back() == ']') v = v.substr(1, v.size() - 2);
+		if (vector && v.size() >= 2 && v.front() == '[' && v.back() == ']')
+			v = v.substr(1, v.size() - 2);
 		std::replace(v.begin(), v.end(), ',', ' ');
 		std::istringstream ss(v);
 		int count = 0;
@@ -151,9 +154,8 @@ void requireIniNumbers(
 		throw IniValueError(
 			section, key,
 			(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " +
-				key + " = '" + trim(raw) +
-			"': not " + (vector ? "a list of " : "a ") + (integers ? "whole" : "finite") +
-			(vector ? " numbers" : " number"));
+				key + " = '" + trim(raw) + "': not " + (vector ? "a list of " : "a ") +
+				(integers ? "whole" : "finite") + (vector ? " numbers" : " number"));
 	}
 }
 

@@ -16,7 +16,8 @@
 #include <sstream>
 
 //  Map definition: [MetricMap] codedLandmarksMap_count=1 builds one.
-MAP_DEFINITION_REGISTER("codemark::CCodedLandmarksMap,codedLandmarksMap", codemark::CCodedLandmarksMap)
+MAP_DEFINITION_REGISTER(
+	"codemark::CCodedLandmarksMap,codedLandmarksMap", codemark::CCodedLandmarksMap)
 
 IMPLEMENTS_SERIALIZABLE(CCodedLandmarksMap, mrpt::maps::CMetricMap, codemark)
 
@@ -50,7 +51,8 @@ inline double wrapDiff(double a)
 struct InLandmark
 {
 	double xl, yl, ux, uy;
-	InLandmark(double cam_x, double cam_y, double cam_cos, double cam_sin, double lm_x, double lm_y,
+	InLandmark(
+		double cam_x, double cam_y, double cam_cos, double cam_sin, double lm_x, double lm_y,
 		double lm_cos, double lm_sin)
 	{
 		const double dx = cam_x - lm_x, dy = cam_y - lm_y;
@@ -86,7 +88,8 @@ double logMixture(double log_gauss, double log_uniform, double p)
  * fixed-size closed-form inverse; +inf-free: returns false when C is not
  * positive definite. */
 template <int K>
-bool logGauss(const Eigen::Matrix<double, K, 1>& r, const Eigen::Matrix<double, K, K>& C, double& out)
+bool logGauss(
+	const Eigen::Matrix<double, K, 1>& r, const Eigen::Matrix<double, K, K>& C, double& out)
 {
 	const double det = C.determinant();
 	if (!(det > 0) || !std::isfinite(det)) return false;
@@ -118,7 +121,8 @@ void CCodedLandmarksMap::TLikelihoodOptions::loadFromConfigFile(
 void CCodedLandmarksMap::TLikelihoodOptions::saveToConfigFile(
 	mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "outlier_probability", outlier_probability, -1, -1, "uniform's weight in the mixture");
+	c.write(
+		s, "outlier_probability", outlier_probability, -1, -1, "uniform's weight in the mixture");
 	c.write(s, "sigma_scale", sigma_scale, -1, -1, "multiplies each std of C_L");
 	c.write(s, "min_std_range_m", min_std_range_m, -1, -1, "added in quadrature [m]");
 	c.write(s, "min_std_angle_deg", min_std_angle_deg, -1, -1, "added in quadrature [deg]");
@@ -174,7 +178,8 @@ void CCodedLandmarksMap::rebuildIndex()
 	for (size_t i = 0; i < m_map.landmarks.size(); ++i)
 	{
 		const int id = m_map.landmarks[i].id;
-		if (id >= 0 && id < kMaxIndexedId) m_index[static_cast<size_t>(id)] = static_cast<int32_t>(i);
+		if (id >= 0 && id < kMaxIndexedId)
+			m_index[static_cast<size_t>(id)] = static_cast<int32_t>(i);
 	}
 }
 
@@ -283,14 +288,16 @@ double CCodedLandmarksMap::scoreL(
 	const double log_uniform = -std::log(o.max_range_m * kTwoPi * kTwoPi);
 	const Eigen::Matrix3d C = inflatedCovariance(C_L);
 	const double det = C.determinant();
-	if (!(det > 0) || !std::isfinite(det)) return log_uniform;  // unusable covariance: no information
+	if (!(det > 0) || !std::isfinite(det))
+		return log_uniform;	 // unusable covariance: no information
 	const double log_norm = -0.5 * (3 * std::log(kTwoPi) + std::log(det));
 	// Early out before the angles: d^2 >= r_range^2 / C(0,0) for any
 	// positive definite C, so a range residual alone can make the Gaussian
 	// term negligible against the uniform (e^-35).
 	const double r0 = L[0] - std::hypot(xl, yl);
 	const double log_out = p > 0 ? std::log(p) + log_uniform : 0;
-	if (p > 0 && std::log1p(-p) + log_norm - 0.5 * r0 * r0 / C(0, 0) - log_out < -35) return log_out;
+	if (p > 0 && std::log1p(-p) + log_norm - 0.5 * r0 * r0 / C(0, 0) - log_out < -35)
+		return log_out;
 	const double phi2 = std::atan2(-uy, -ux);
 	const double phi1 = wrapNear(std::atan2(yl, xl) - phi2);
 	const Eigen::Vector3d r(r0, wrapDiff(L[1] - phi1), wrapDiff(L[2] - phi2));
@@ -336,8 +343,8 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 		const double sa = o.min_std_angle_deg * M_PI / 180.0;
 		const double sr = o.min_std_range_m;
 		const double span = br->maxSensorDistance > br->minSensorDistance
-			? double(br->maxSensorDistance - br->minSensorDistance)
-			: o.max_range_m;
+								? double(br->maxSensorDistance - br->minSensorDistance)
+								: o.max_range_m;
 		double ll = 0;
 		for (const auto& m : br->sensedData)
 		{
@@ -371,7 +378,8 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 				ok = logGauss<3>(r, C, lg);
 			}
 			else  // a planar sensor (no pitch uncertainty): range and yaw
-				ok = logGauss<2>(Eigen::Vector2d(r.head<2>()), Eigen::Matrix2d(C.topLeftCorner<2, 2>()), lg);
+				ok = logGauss<2>(
+					Eigen::Vector2d(r.head<2>()), Eigen::Matrix2d(C.topLeftCorner<2, 2>()), lg);
 			ll += ok ? logMixture(lg, log_uniform, o.outlier_probability) : log_uniform;
 		}
 		return ll;
@@ -384,7 +392,7 @@ bool CCodedLandmarksMap::internal_canComputeObservationLikelihood(
 {
 	const auto* cls = obs.GetRuntimeClass();
 	return cls == CLASS_ID(CObservationCodedLandmarks) ||
-		cls == CLASS_ID(mrpt::obs::CObservationBearingRange);
+		   cls == CLASS_ID(mrpt::obs::CObservationBearingRange);
 }
 
 // --------------------------------------------------------- serialization
@@ -426,7 +434,8 @@ void CCodedLandmarksMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_
 			setLandmarks(map);
 		}
 		break;
-		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+		default:
+			MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	}
 }
 

@@ -107,7 +107,7 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 				// A detection never has a non-finite measurement; such a value
 				// would only poison a filter later, far from its cause.
 				bool finite = s.P.allFinite() && s.L.allFinite() && s.C_L.allFinite() &&
-					s.pose_in_landmark.allFinite();
+							  s.pose_in_landmark.allFinite();
 				for (const auto& c : s.corners) finite = finite && c.allFinite();
 				if (!finite)
 					THROW_EXCEPTION_FMT(
@@ -117,7 +117,8 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 			}
 		}
 		break;
-		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+		default:
+			MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	}
 }
 
@@ -132,10 +133,10 @@ void CObservationCodedLandmarks::getDescriptionAsText(std::ostream& o) const
 	const auto oldp = o.precision();
 	// Values in fixed notation, their 1-sigma with 3 significant digits:
 	// sub-millimetre and millidegree sigmas must not print as 0.
-	auto val = [&](double v, int decimals) -> std::ostream& {
-		return o << std::fixed << std::setprecision(decimals) << v;
-	};
-	auto sig = [&](double v) -> std::ostream& {
+	auto val = [&](double v, int decimals) -> std::ostream&
+	{ return o << std::fixed << std::setprecision(decimals) << v; };
+	auto sig = [&](double v) -> std::ostream&
+	{
 		o.unsetf(std::ios::floatfield);
 		return o << std::setprecision(3) << v;
 	};
@@ -188,7 +189,8 @@ mrpt::obs::CObservationBearingRange::Ptr CObservationCodedLandmarks::toBearingRa
 {
 	auto br = mrpt::obs::CObservationBearingRange::Create();
 	br->timestamp = timestamp;
-	if (!label.empty()) br->sensorLabel = label;
+	if (!label.empty())
+		br->sensorLabel = label;
 	else
 	{
 		const std::string suffix = "_LANDMARKS";

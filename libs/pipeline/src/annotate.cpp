@@ -24,7 +24,7 @@ namespace
 // One image of the input to process, and what became of it.
 struct Job
 {
-	std::size_t entry;  //!< index of the entry in the chunk
+	std::size_t entry;	//!< index of the entry in the chunk
 	const CObservationImage* image;
 	CObservationCodedLandmarks::Ptr result;
 	double detect_us = 0;
@@ -38,7 +38,8 @@ void linkImagesFolder(const std::string& in_path, const std::string& out_path)
 	const fs::path in_dir = imagesDirectoryOf(in_path), out_dir = imagesDirectoryOf(out_path);
 	std::error_code ec;
 	if (!fs::exists(in_dir, ec) || fs::exists(out_dir, ec)) return;
-	if (fs::equivalent(fs::absolute(in_dir).parent_path(), fs::absolute(out_dir).parent_path(), ec) &&
+	if (fs::equivalent(
+			fs::absolute(in_dir).parent_path(), fs::absolute(out_dir).parent_path(), ec) &&
 		in_dir.filename() == out_dir.filename())
 		return;
 	fs::create_directory_symlink(fs::absolute(in_dir), out_dir, ec);
@@ -50,7 +51,8 @@ void linkImagesFolder(const std::string& in_path, const std::string& out_path)
 void runJobs(std::vector<Job>& jobs, const AnnotateOptions& o, int threads)
 {
 	std::atomic<std::size_t> next{0};
-	auto work = [&] {
+	auto work = [&]
+	{
 		for (std::size_t i; (i = next++) < jobs.size();)
 		{
 			Job& j = jobs[i];
@@ -91,8 +93,8 @@ AnnotateSummary annotateRawlog(
 
 	auto ar_in = mrpt::serialization::archiveFrom(in);
 	auto ar_out = mrpt::serialization::archiveFrom(out);
-	const int threads = o.threads > 0 ? o.threads
-									  : std::max(1u, std::thread::hardware_concurrency());
+	const int threads =
+		o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
 	const std::size_t chunk = 8 * static_cast<std::size_t>(threads);
 	double detect_us_total = 0;
 	bool eof = false;
@@ -118,18 +120,20 @@ AnnotateSummary annotateRawlog(
 				throw std::runtime_error(
 					in_path + ": entry #" + std::to_string(sum.entries) +
 					" cannot be read (truncated or corrupt file, or a class whose plugin is not "
-					"loaded): " + mrpt::exception_to_str(e));
+					"loaded): " +
+					mrpt::exception_to_str(e));
 			}
 			const bool known = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj) ||
-				std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj) ||
-				std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
+							   std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj) ||
+							   std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
 			if (!known)
 				throw std::runtime_error(
 					in_path + ": entry #" + std::to_string(sum.entries) + " holds a '" +
 					(obj ? obj->GetRuntimeClass()->className : "null") +
 					"', which is not a rawlog entry (CSensoryFrame, CActionCollection or "
 					"CObservation)");
-			if (!std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) sum.actions_observations = true;
+			if (!std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj))
+				sum.actions_observations = true;
 			entries.push_back(obj);
 			++sum.entries;
 		}
@@ -153,8 +157,9 @@ AnnotateSummary annotateRawlog(
 		{
 			if (!j.error.empty())
 				throw std::runtime_error(
-					in_path + ": entry #" + std::to_string(first_entry + static_cast<long>(j.entry)) +
-					" (" + j.image->sensorLabel + "): " + j.error);
+					in_path + ": entry #" +
+					std::to_string(first_entry + static_cast<long>(j.entry)) + " (" +
+					j.image->sensorLabel + "): " + j.error);
 			++sum.images;
 			detect_us_total += j.detect_us;
 			sum.detections += static_cast<long>(j.result->sightings.size());
@@ -163,7 +168,8 @@ AnnotateSummary annotateRawlog(
 
 		// Write in input order, each landmark observation right after its image.
 		std::size_t next_job = 0;
-		auto resultFor = [&](const CObservationImage* img) {
+		auto resultFor = [&](const CObservationImage* img)
+		{
 			while (next_job < jobs.size() && jobs[next_job].image != img) ++next_job;
 			return jobs.at(next_job).result;
 		};

@@ -11,7 +11,8 @@ namespace codemark::pipeline
 LandmarkGeometry geometryFor(int id, const PipelineOptions& o)
 {
 	if (o.map)
-		if (const auto* l = o.map->find(id); l && l->scale != 1.0) return o.geometry.scaledBy(l->scale);
+		if (const auto* l = o.map->find(id); l && l->scale != 1.0)
+			return o.geometry.scaledBy(l->scale);
 	return o.geometry;
 }
 
@@ -29,8 +30,8 @@ ImageResult processImage(
 		m.detected = d;
 		try
 		{
-			m.measurement = pose::measure(
-				d.detection.corners, camera, geometryFor(d.detection.id, o), o.pose);
+			m.measurement =
+				pose::measure(d.detection.corners, camera, geometryFor(d.detection.id, o), o.pose);
 		}
 		catch (const std::invalid_argument&)
 		{
@@ -54,21 +55,21 @@ cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img)
 	catch (const std::exception& e)
 	{
 		const std::string f = img.image.isExternallyStored()
-			? img.image.getExternalStorageFileAbsolutePath()
-			: std::string("embedded image");
+								  ? img.image.getExternalStorageFileAbsolutePath()
+								  : std::string("embedded image");
 		throw std::runtime_error("cannot load image '" + f + "': " + e.what());
 	}
 	if (m.empty())
 	{
 		const std::string f = img.image.isExternallyStored()
-			? img.image.getExternalStorageFileAbsolutePath()
-			: std::string("embedded image");
+								  ? img.image.getExternalStorageFileAbsolutePath()
+								  : std::string("embedded image");
 		throw std::runtime_error("cannot load image '" + f + "' (missing or empty)");
 	}
 	cv::Mat bgr;
-	if (m.depth() != CV_8U)
-		throw std::runtime_error("image is not 8-bit per channel");
-	if (m.channels() == 1) cv::cvtColor(m, bgr, cv::COLOR_GRAY2BGR);
+	if (m.depth() != CV_8U) throw std::runtime_error("image is not 8-bit per channel");
+	if (m.channels() == 1)
+		cv::cvtColor(m, bgr, cv::COLOR_GRAY2BGR);
 	else if (m.channels() == 4)
 		cv::cvtColor(m, bgr, cv::COLOR_BGRA2BGR);
 	else
@@ -79,7 +80,8 @@ cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img)
 CObservationCodedLandmarks::Ptr observeImage(
 	const mrpt::obs::CObservationImage& img, const PipelineOptions& o, ImageResult* out)
 {
-	const CameraModel camera = o.camera_override ? *o.camera_override : CameraModel(img.cameraParams);
+	const CameraModel camera =
+		o.camera_override ? *o.camera_override : CameraModel(img.cameraParams);
 	const cv::Mat bgr = imageAsBgr(img);
 	if (bgr.cols != camera.width() || bgr.rows != camera.height())
 		throw std::runtime_error(

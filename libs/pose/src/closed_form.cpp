@@ -56,8 +56,8 @@ Eigen::Vector3d poseFromLandmark(const Eigen::Vector3d& L, Eigen::Matrix3d* J_L)
 	const double c = std::cos(a), sn = std::sin(a);
 	if (J_L)
 	{
-		*J_L << c, -l2 * sn, -l2 * sn,  //
-			sn, l2 * c, l2 * c,  //
+		*J_L << c, -l2 * sn, -l2 * sn,	//
+			sn, l2 * c, l2 * c,	 //
 			0, 0, 1;
 	}
 	return {l2 * c, l2 * sn, wrapToPi(M_PI + L[2])};
@@ -73,10 +73,10 @@ Eigen::Matrix3d poseCovarianceSecondOrder(const Eigen::Vector3d& L, const Eigen:
 	// (l2, phi1, phi2); theta = pi + phi2 is linear.
 	Eigen::Matrix3d H[2];
 	H[0] << 0, -sn, -sn,  //
-		-sn, -l2 * c, -l2 * c,  //
+		-sn, -l2 * c, -l2 * c,	//
 		-sn, -l2 * c, -l2 * c;
 	H[1] << 0, c, c,  //
-		c, -l2 * sn, -l2 * sn,  //
+		c, -l2 * sn, -l2 * sn,	//
 		c, -l2 * sn, -l2 * sn;
 	Eigen::Matrix3d C = J_L * C_L * J_L.transpose();
 	for (int i = 0; i < 2; ++i)
@@ -109,7 +109,7 @@ mrpt::poses::CPose2D robotPoseInWorld(
 {
 	using mrpt::poses::CPose2D;
 	const CPose2D world_T_camera = world_T_landmark + CPose2D(c[0], c[1], c[2]);
-	const CPose2D camera_T_robot = CPose2D() - robot_T_camera;  // inverse
+	const CPose2D camera_T_robot = CPose2D() - robot_T_camera;	// inverse
 	const CPose2D world_T_robot = world_T_camera + camera_T_robot;
 	if (C_world || J_out)
 	{

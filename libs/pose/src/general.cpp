@@ -95,8 +95,9 @@ bool samePose(const Vec6& a, const Vec6& b)
 std::array<Eigen::Vector3d, 4> modelPoints(const LandmarkGeometry& g)
 {
 	const double h = g.innerHalf();
-	return {Eigen::Vector3d(-h, -h, 0), Eigen::Vector3d(h, -h, 0), Eigen::Vector3d(h, h, 0),
-			Eigen::Vector3d(-h, h, 0)};
+	return {
+		Eigen::Vector3d(-h, -h, 0), Eigen::Vector3d(h, -h, 0), Eigen::Vector3d(h, h, 0),
+		Eigen::Vector3d(-h, h, 0)};
 }
 
 mrpt::poses::CPose3D landmarkTCameraFromRvecTvec(const Eigen::Matrix<double, 6, 1>& p)
@@ -150,8 +151,7 @@ GeneralPose solveGeneralPose(
 			cv::solvePnPRefineLM(
 				obj, img, K, dist, r, t,
 				cv::TermCriteria(
-					cv::TermCriteria::COUNT + cv::TermCriteria::EPS, lm_max_iterations,
-					1e-12));
+					cv::TermCriteria::COUNT + cv::TermCriteria::EPS, lm_max_iterations, 1e-12));
 			Vec6 p;
 			p << r.at<double>(0), r.at<double>(1), r.at<double>(2), t.at<double>(0),
 				t.at<double>(1), t.at<double>(2);
@@ -163,9 +163,9 @@ GeneralPose solveGeneralPose(
 	std::vector<PnPSolution> sols;
 	for (const Vec6& p : candidates)
 	{
-		if (std::any_of(sols.begin(), sols.end(), [&](const PnPSolution& s) {
-				return samePose(s.rvec_tvec, p);
-			}))
+		if (std::any_of(
+				sols.begin(), sols.end(),
+				[&](const PnPSolution& s) { return samePose(s.rvec_tvec, p); }))
 			continue;
 		const Projection pr = project(obj, img, p, K, dist);
 		PnPSolution s;
@@ -177,17 +177,18 @@ GeneralPose solveGeneralPose(
 		// Only the landmark's front side is printed: a camera behind it is no solution.
 		if (s.landmark_T_camera.x() > 0) sols.push_back(s);
 	}
-	if (sols.empty()) throw std::runtime_error("solveGeneralPose: no PnP solution in front of the landmark");
-	std::sort(sols.begin(), sols.end(), [](const PnPSolution& a, const PnPSolution& b) {
-		return a.rms_px < b.rms_px;
-	});
+	if (sols.empty())
+		throw std::runtime_error("solveGeneralPose: no PnP solution in front of the landmark");
+	std::sort(
+		sols.begin(), sols.end(),
+		[](const PnPSolution& a, const PnPSolution& b) { return a.rms_px < b.rms_px; });
 	if (sols.size() > 2) sols.resize(2);
 
 	GeneralPose out;
 	out.solutions = sols;
 	out.ambiguity_ratio = (sols.size() < 2 || sols[0].rms_px <= 0)
-		? std::numeric_limits<double>::infinity()
-		: sols[1].rms_px / sols[0].rms_px;
+							  ? std::numeric_limits<double>::infinity()
+							  : sols[1].rms_px / sols[0].rms_px;
 
 	// Reduction to (L, pose_in_landmark) with its Jacobian by central
 	// differences; angle differences wrapped.

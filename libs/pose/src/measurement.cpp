@@ -55,17 +55,22 @@ void PoseOptions::validate() const
 		throw std::invalid_argument(s.str());
 	}
 	if (!(sigma_y_px >= 0) || !std::isfinite(sigma_y_px))
-		throw std::invalid_argument("pose options: sigma_y_px must be finite and >= 0 (0: sigma_px)");
+		throw std::invalid_argument(
+			"pose options: sigma_y_px must be finite and >= 0 (0: sigma_px)");
 	if (!(min_sigma_px > 0) || !std::isfinite(min_sigma_px))
 		throw std::invalid_argument("pose options: min_sigma_px must be finite and > 0");
-	if (!(growth_x_px >= 0) || !(growth_y_px >= 0) || !std::isfinite(growth_x_px) || !std::isfinite(growth_y_px))
-		throw std::invalid_argument("pose options: growth_x_px, growth_y_px must be finite and >= 0");
-	if (!(size_reference_px > 0) || !std::isfinite(size_reference_px) || !std::isfinite(size_exponent_x) ||
-		!std::isfinite(size_exponent_y))
-		throw std::invalid_argument("pose options: size_reference_px must be > 0 and the exponents finite");
+	if (!(growth_x_px >= 0) || !(growth_y_px >= 0) || !std::isfinite(growth_x_px) ||
+		!std::isfinite(growth_y_px))
+		throw std::invalid_argument(
+			"pose options: growth_x_px, growth_y_px must be finite and >= 0");
+	if (!(size_reference_px > 0) || !std::isfinite(size_reference_px) ||
+		!std::isfinite(size_exponent_x) || !std::isfinite(size_exponent_y))
+		throw std::invalid_argument(
+			"pose options: size_reference_px must be > 0 and the exponents finite");
 	for (const double r : {corr_x12, corr_y12, corr_growth_x12, corr_growth_y12})
 		if (!(std::abs(r) < 1))
-			throw std::invalid_argument("pose options: the correlations corr_* must lie in (-1, 1)");
+			throw std::invalid_argument(
+				"pose options: the correlations corr_* must lie in (-1, 1)");
 	if (lm_max_iterations < 1)
 		throw std::invalid_argument("pose options: lm_max_iterations must be >= 1");
 }
@@ -93,22 +98,43 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 
 void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "method", toString(method), -1, -1, "ClosedForm (paper, level camera) | General6Dof (PnP)");
-	c.write(s, "sigma_px", sigma_px, -1, -1, "std. dev. of x1, x2 (and y1, y2 unless sigma_y_px) [px]");
+	c.write(
+		s, "method", toString(method), -1, -1,
+		"ClosedForm (paper, level camera) | General6Dof (PnP)");
+	c.write(
+		s, "sigma_px", sigma_px, -1, -1, "std. dev. of x1, x2 (and y1, y2 unless sigma_y_px) [px]");
 	c.write(s, "sigma_y_px", sigma_y_px, -1, -1, "std. dev. of y1, y2 [px]; 0: sigma_px");
-	c.write(s, "sigma_source", toString(sigma_source), -1, -1, "Fixed (sigma_px) | Detector (its corner_sigma_px)");
-	c.write(s, "growth_x_px", growth_x_px, -1, -1, "growth of sigma(x1, x2) for small landmarks [px]; 0: constant");
-	c.write(s, "growth_y_px", growth_y_px, -1, -1, "growth of sigma(y1, y2) for small landmarks [px]; 0: constant");
-	c.write(s, "size_exponent_x", size_exponent_x, -1, -1, "sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
-	c.write(s, "size_exponent_y", size_exponent_y, -1, -1, "sigma_y = sqrt(sigma_y_px^2 + (growth_y_px (ref / (y1 + y2))^exp)^2)");
+	c.write(
+		s, "sigma_source", toString(sigma_source), -1, -1,
+		"Fixed (sigma_px) | Detector (its corner_sigma_px)");
+	c.write(
+		s, "growth_x_px", growth_x_px, -1, -1,
+		"growth of sigma(x1, x2) for small landmarks [px]; 0: constant");
+	c.write(
+		s, "growth_y_px", growth_y_px, -1, -1,
+		"growth of sigma(y1, y2) for small landmarks [px]; 0: constant");
+	c.write(
+		s, "size_exponent_x", size_exponent_x, -1, -1,
+		"sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
+	c.write(
+		s, "size_exponent_y", size_exponent_y, -1, -1,
+		"sigma_y = sqrt(sigma_y_px^2 + (growth_y_px (ref / (y1 + y2))^exp)^2)");
 	c.write(s, "size_reference_px", size_reference_px, -1, -1, "ref of the growth terms [px]");
-	c.write(s, "corr_x12", corr_x12, -1, -1, "correlation of the errors of x1 and x2, constant part");
+	c.write(
+		s, "corr_x12", corr_x12, -1, -1, "correlation of the errors of x1 and x2, constant part");
 	c.write(s, "corr_growth_x12", corr_growth_x12, -1, -1, "the same, size-dependent part");
-	c.write(s, "corr_y12", corr_y12, -1, -1, "correlation of the errors of y1 and y2, constant part");
+	c.write(
+		s, "corr_y12", corr_y12, -1, -1, "correlation of the errors of y1 and y2, constant part");
 	c.write(s, "corr_growth_y12", corr_growth_y12, -1, -1, "the same, size-dependent part");
-	c.write(s, "second_order_pose_covariance", second_order_pose_covariance, -1, -1, "ClosedForm: C_R to second order in C_L");
-	c.write(s, "min_sigma_px", min_sigma_px, -1, -1, "Detector: floor of the sigma of a component of P [px]");
-	c.write(s, "lm_max_iterations", lm_max_iterations, -1, -1, "General6Dof: LM iterations per refinement");
+	c.write(
+		s, "second_order_pose_covariance", second_order_pose_covariance, -1, -1,
+		"ClosedForm: C_R to second order in C_L");
+	c.write(
+		s, "min_sigma_px", min_sigma_px, -1, -1,
+		"Detector: floor of the sigma of a component of P [px]");
+	c.write(
+		s, "lm_max_iterations", lm_max_iterations, -1, -1,
+		"General6Dof: LM iterations per refinement");
 }
 
 Eigen::Matrix4d PoseOptions::primaryCovariance(const Eigen::Vector4d& P) const
@@ -143,16 +169,17 @@ Measurement measure(
 		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), &J_P);
 		m.C_L = J_P * m.C_P * J_P.transpose();
 		m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
-		m.C_R = options.second_order_pose_covariance ? poseCovarianceSecondOrder(m.L, m.C_L)
-													: Eigen::Matrix3d(J_L * m.C_L * J_L.transpose());
+		m.C_R = options.second_order_pose_covariance
+					? poseCovarianceSecondOrder(m.L, m.C_L)
+					: Eigen::Matrix3d(J_L * m.C_L * J_L.transpose());
 		return m;
 	}
 	// Each corner coordinate carries sqrt(2) sigma when each component of P
 	// (a mean or half-difference of two corners) carries sigma; the general
 	// path takes one isotropic corner sigma: the RMS of the two.
 	const double sigma_corner = std::sqrt(m.C_P(0, 0) + m.C_P(1, 1));
-	const GeneralPose g = solveGeneralPose(
-		corners, camera, geometry, sigma_corner, options.lm_max_iterations);
+	const GeneralPose g =
+		solveGeneralPose(corners, camera, geometry, sigma_corner, options.lm_max_iterations);
 	m.L = g.L;
 	m.C_L = g.C_L;
 	m.pose_in_landmark = g.pose_in_landmark;

@@ -25,16 +25,23 @@ void VisibilityOptions::saveToConfigFile(
 	mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "max_range_m", max_range_m, -1, -1, "maximum horizontal distance [m]");
-	c.write(s, "max_view_angle_deg", max_view_angle_deg, -1, -1, "maximum angle of view from the normal [deg]");
-	c.write(s, "min_size_px", min_size_px, -1, -1, "minimum vertical size of the reference square [px]");
-	c.write(s, "image_margin_px", image_margin_px, -1, -1, "outer frame this far inside the image [px]");
+	c.write(
+		s, "max_view_angle_deg", max_view_angle_deg, -1, -1,
+		"maximum angle of view from the normal [deg]");
+	c.write(
+		s, "min_size_px", min_size_px, -1, -1,
+		"minimum vertical size of the reference square [px]");
+	c.write(
+		s, "image_margin_px", image_margin_px, -1, -1,
+		"outer frame this far inside the image [px]");
 }
 
 mrpt::poses::CPose3D worldTCamera(
 	const mrpt::poses::CPose2D& world_T_robot, const mrpt::poses::CPose3D& robot_T_camera)
 {
-	return mrpt::poses::CPose3D(world_T_robot.x(), world_T_robot.y(), 0, world_T_robot.phi(), 0, 0) +
-		robot_T_camera;
+	return mrpt::poses::CPose3D(
+			   world_T_robot.x(), world_T_robot.y(), 0, world_T_robot.phi(), 0, 0) +
+		   robot_T_camera;
 }
 
 Eigen::Matrix3d fuseCovariance(const Eigen::Matrix3d& prior, const Eigen::Matrix3d& C_fix)
@@ -57,7 +64,8 @@ Prediction predictSighting(
 		worldTCamera(world_T_robot, robot_T_camera) - world_T_landmark;
 	const mrpt::poses::CPose3D camera_T_landmark = -landmark_T_camera;
 
-	const auto toCamera = [&](const Eigen::Vector3d& pL) {
+	const auto toCamera = [&](const Eigen::Vector3d& pL)
+	{
 		mrpt::math::TPoint3D q;
 		camera_T_landmark.composePoint(mrpt::math::TPoint3D(pL.x(), pL.y(), pL.z()), q);
 		return Eigen::Vector3d(q.x, q.y, q.z);
@@ -74,8 +82,9 @@ Prediction predictSighting(
 	const double H = g.outerHalf();
 	pr.in_front = true;
 	pr.in_fov = true;
-	for (const auto& st : {Eigen::Vector2d(-H, H), Eigen::Vector2d(H, H), Eigen::Vector2d(H, -H),
-						   Eigen::Vector2d(-H, -H)})
+	for (const auto& st :
+		 {Eigen::Vector2d(-H, H), Eigen::Vector2d(H, H), Eigen::Vector2d(H, -H),
+		  Eigen::Vector2d(-H, -H)})
 	{
 		const auto px = camera.project(toCamera(LandmarkGeometry::faceToLandmark(st.x(), st.y())));
 		if (!px)
@@ -132,9 +141,9 @@ std::vector<Prediction> rankLandmarks(
 			predictSighting(world_T_robot, robot_cov, robot_T_camera, camera, lm, options, vis);
 		if (p.visible()) out.push_back(std::move(p));
 	}
-	std::stable_sort(out.begin(), out.end(), [](const Prediction& a, const Prediction& b) {
-		return a.score < b.score;
-	});
+	std::stable_sort(
+		out.begin(), out.end(),
+		[](const Prediction& a, const Prediction& b) { return a.score < b.score; });
 	return out;
 }
 

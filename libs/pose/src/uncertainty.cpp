@@ -27,8 +27,8 @@ std::string fmt(double v, int prec)
 }  // namespace
 
 SightingUncertainty predictUncertainty(
-	const CameraModel& camera, const LandmarkGeometry& g, double sigma_px, double d,
-	double angle, double bearing, double height)
+	const CameraModel& camera, const LandmarkGeometry& g, double sigma_px, double d, double angle,
+	double bearing, double height)
 {
 	using mrpt::poses::CPose3D;
 	SightingUncertainty out;
@@ -36,20 +36,22 @@ SightingUncertainty predictUncertainty(
 		CPose3D(d * std::cos(angle), d * std::sin(angle), height, angle + M_PI - bearing, 0, 0) +
 		CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	const CPose3D camera_T_landmark = -landmark_T_camera;
-	const auto toCamera = [&](const Eigen::Vector3d& p) {
+	const auto toCamera = [&](const Eigen::Vector3d& p)
+	{
 		mrpt::math::TPoint3D q;
 		camera_T_landmark.composePoint(mrpt::math::TPoint3D(p.x(), p.y(), p.z()), q);
 		return Eigen::Vector3d(q.x, q.y, q.z);
 	};
 	const double H = g.outerHalf();
 	bool in_image = true;
-	for (const auto& st : {Eigen::Vector2d(-H, H), Eigen::Vector2d(H, H), Eigen::Vector2d(H, -H),
-						   Eigen::Vector2d(-H, -H)})
+	for (const auto& st :
+		 {Eigen::Vector2d(-H, H), Eigen::Vector2d(H, H), Eigen::Vector2d(H, -H),
+		  Eigen::Vector2d(-H, -H)})
 	{
 		const auto px = camera.project(toCamera(LandmarkGeometry::faceToLandmark(st.x(), st.y())));
 		if (!px) return out;
 		in_image = in_image && px->x() >= -0.5 && px->y() >= -0.5 &&
-			px->x() <= camera.width() - 0.5 && px->y() <= camera.height() - 0.5;
+				   px->x() <= camera.width() - 0.5 && px->y() <= camera.height() - 0.5;
 	}
 	if (!(landmark_T_camera.x() > 0)) return out;
 	std::array<Eigen::Vector2d, 4> corners;
@@ -69,8 +71,8 @@ SightingUncertainty predictUncertainty(
 	out.sigma_phi1_rad = std::sqrt(m.C_L(1, 1));
 	out.sigma_phi2_rad = std::sqrt(m.C_L(2, 2));
 	const Eigen::Matrix2d Cxy = m.C_R.topLeftCorner<2, 2>();
-	out.sigma_position_m =
-		std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(Cxy).eigenvalues()[1]));
+	out.sigma_position_m = std::sqrt(
+		std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(Cxy).eigenvalues()[1]));
 	out.sigma_heading_rad = std::sqrt(m.C_R(2, 2));
 	return out;
 }
@@ -80,16 +82,15 @@ SizeAdvice sizeFor(
 	double distance_m, double angle, double k, double min_size_px)
 {
 	if (!(position_m > 0) || !(heading_rad > 0) || !(distance_m > 0) || !(k > 0) || !(sigma_px > 0))
-		throw std::invalid_argument("sizeFor: accuracies, distance, k_sigma and sigma_px must be > 0");
+		throw std::invalid_argument(
+			"sizeFor: accuracies, distance, k_sigma and sigma_px must be > 0");
 	const auto at = [&](double s) {
 		return predictUncertainty(camera, LandmarkGeometry::scaled(s), sigma_px, distance_m, angle);
 	};
-	const auto accurate = [&](const SightingUncertainty& u) {
-		return k * u.sigma_position_m <= position_m && k * u.sigma_heading_rad <= heading_rad;
-	};
-	const auto ok = [&](const SightingUncertainty& u) {
-		return u.in_image && u.size_px >= min_size_px && accurate(u);
-	};
+	const auto accurate = [&](const SightingUncertainty& u)
+	{ return k * u.sigma_position_m <= position_m && k * u.sigma_heading_rad <= heading_rad; };
+	const auto ok = [&](const SightingUncertainty& u)
+	{ return u.in_image && u.size_px >= min_size_px && accurate(u); };
 	SizeAdvice out;
 	// The largest scale that still fits in the image.
 	double lo = 1e-3, hi = 1.0;
@@ -110,8 +111,8 @@ SizeAdvice sizeFor(
 	{
 		std::ostringstream s;
 		s << "even the largest landmark that fits in the image (scale " << fmt(s_max, 2)
-		  << ", outer frame " << fmt(0.2 * s_max, 3) << " m) gives " << fmt(k, 1) << " sigma = "
-		  << fmt(k * best.sigma_position_m * 1000, 1) << " mm and "
+		  << ", outer frame " << fmt(0.2 * s_max, 3) << " m) gives " << fmt(k, 1)
+		  << " sigma = " << fmt(k * best.sigma_position_m * 1000, 1) << " mm and "
 		  << fmt(k * best.sigma_heading_rad * 180 / M_PI, 2) << " deg";
 		out.reason = s.str();
 		out.scale = s_max;
@@ -152,9 +153,9 @@ std::string describeSizeAdvice(const SizeAdvice& a, double k)
 	  << fmt(g.outer_size_m * 1000, 1) << " mm, reference square " << fmt(g.inner_size_m * 1000, 1)
 	  << " mm, code cells " << fmt(g.cell_size_m * 1000, 1) << " mm\n";
 	s << "predicted there: reference square " << fmt(a.at.size_px, 1) << " px tall; " << fmt(k, 1)
-	  << " sigma: position " << fmt(k * a.at.sigma_position_m * 1000, 2) << " mm (worst direction), heading "
-	  << fmt(k * a.at.sigma_heading_rad * 180 / M_PI, 3) << " deg, range "
-	  << fmt(k * a.at.sigma_l2_m * 1000, 2) << " mm\n";
+	  << " sigma: position " << fmt(k * a.at.sigma_position_m * 1000, 2)
+	  << " mm (worst direction), heading " << fmt(k * a.at.sigma_heading_rad * 180 / M_PI, 3)
+	  << " deg, range " << fmt(k * a.at.sigma_l2_m * 1000, 2) << " mm\n";
 	return s.str();
 }
 
@@ -164,10 +165,10 @@ std::string accuracyTable(
 {
 	const LandmarkGeometry g = LandmarkGeometry::scaled(scale);
 	std::ostringstream s;
-	s << "# landmark scale " << fmt(scale, 3) << " (reference square " << fmt(g.inner_size_m * 1000, 1)
-	  << " mm), view angle " << fmt(angle * 180 / M_PI, 1) << " deg, sigma_px " << fmt(sigma_px, 3)
-	  << ", camera " << camera.width() << "x" << camera.height() << " fx " << fmt(camera.fx(), 1)
-	  << "; 1-sigma values\n";
+	s << "# landmark scale " << fmt(scale, 3) << " (reference square "
+	  << fmt(g.inner_size_m * 1000, 1) << " mm), view angle " << fmt(angle * 180 / M_PI, 1)
+	  << " deg, sigma_px " << fmt(sigma_px, 3) << ", camera " << camera.width() << "x"
+	  << camera.height() << " fx " << fmt(camera.fx(), 1) << "; 1-sigma values\n";
 	s << "# dist_m  size_px  l2_mm  phi1_deg  phi2_deg  pos_mm  heading_deg  usable\n";
 	for (const double d : distances)
 	{
@@ -180,9 +181,12 @@ std::string accuracyTable(
 		}
 		s << std::setw(9) << fmt(u.size_px, 1) << std::setw(7) << fmt(u.sigma_l2_m * 1000, 2)
 		  << std::setw(10) << fmt(u.sigma_phi1_rad * 180 / M_PI, 4) << std::setw(10)
-		  << fmt(u.sigma_phi2_rad * 180 / M_PI, 3) << std::setw(8) << fmt(u.sigma_position_m * 1000, 1)
-		  << std::setw(13) << fmt(u.sigma_heading_rad * 180 / M_PI, 3) << "  "
-		  << (!u.in_image ? "no (not in image)" : u.size_px < min_size_px ? "no (too small)" : "yes")
+		  << fmt(u.sigma_phi2_rad * 180 / M_PI, 3) << std::setw(8)
+		  << fmt(u.sigma_position_m * 1000, 1) << std::setw(13)
+		  << fmt(u.sigma_heading_rad * 180 / M_PI, 3) << "  "
+		  << (!u.in_image				? "no (not in image)"
+			  : u.size_px < min_size_px ? "no (too small)"
+										: "yes")
 		  << "\n";
 	}
 	return s.str();
@@ -219,7 +223,8 @@ FigureScales drawUncertaintyFigure(
 		}
 
 	// Round down to 1-2-5 x 10^n.
-	const auto round125 = [](double v) {
+	const auto round125 = [](double v)
+	{
 		const double p = std::pow(10.0, std::floor(std::log10(v)));
 		const double f = v / p;
 		return p * (f >= 5 ? 5 : f >= 2 ? 2 : 1);
@@ -237,8 +242,11 @@ FigureScales drawUncertaintyFigure(
 	cv::Mat img(Hh, std::max(W, 900), CV_8UC3, cv::Scalar(255, 255, 255));
 	const double u0 = img.cols / 2.0, v0 = header + 0.35 * ppm;
 	// Top view: X_L (outward normal) down the image, Y_L to the right.
-	const auto S = [&](double X, double Y) {
-		return cv::Point(static_cast<int>(std::lround(u0 + Y * ppm)), static_cast<int>(std::lround(v0 + X * ppm)));
+	const auto S = [&](double X, double Y)
+	{
+		return cv::Point(
+			static_cast<int>(std::lround(u0 + Y * ppm)),
+			static_cast<int>(std::lround(v0 + X * ppm)));
 	};
 	const cv::Scalar black(0, 0, 0), grey(170, 170, 170), red(30, 30, 220), blue(200, 90, 20),
 		green(0, 190, 0);
@@ -246,15 +254,24 @@ FigureScales drawUncertaintyFigure(
 	// Distance rings and labels.
 	for (double r = 1; r <= std::hypot(o.x_max_m, o.y_max_m) + 1e-9; r += 1)
 	{
-		cv::ellipse(img, S(0, 0), cv::Size(int(r * ppm), int(r * ppm)), 0, 0, 180, cv::Scalar(225, 225, 225), 1, cv::LINE_AA);
-		cv::putText(img, fmt(r, 0) + " m", S(r, 0) + cv::Point(4, -4), cv::FONT_HERSHEY_SIMPLEX, 0.4, grey, 1, cv::LINE_AA);
+		cv::ellipse(
+			img, S(0, 0), cv::Size(int(r * ppm), int(r * ppm)), 0, 0, 180,
+			cv::Scalar(225, 225, 225), 1, cv::LINE_AA);
+		cv::putText(
+			img, fmt(r, 0) + " m", S(r, 0) + cv::Point(4, -4), cv::FONT_HERSHEY_SIMPLEX, 0.4, grey,
+			1, cv::LINE_AA);
 	}
 	// The landmark (outer frame, drawn to scale but at least 8 px wide).
 	const int half_px = std::max(4, int(std::lround(g.outerHalf() * ppm)));
-	cv::rectangle(img, S(0, 0) + cv::Point(-half_px, -5), S(0, 0) + cv::Point(half_px, 0), black, cv::FILLED);
-	cv::rectangle(img, S(0, 0) + cv::Point(-half_px + 2, -4), S(0, 0) + cv::Point(half_px - 2, -1), green, cv::FILLED);
+	cv::rectangle(
+		img, S(0, 0) + cv::Point(-half_px, -5), S(0, 0) + cv::Point(half_px, 0), black, cv::FILLED);
+	cv::rectangle(
+		img, S(0, 0) + cv::Point(-half_px + 2, -4), S(0, 0) + cv::Point(half_px - 2, -1), green,
+		cv::FILLED);
 	cv::arrowedLine(img, S(0, 0), S(0.3, 0), grey, 1, cv::LINE_AA, 0, 0.2);
-	cv::putText(img, "X_L", S(0.3, 0) + cv::Point(4, 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, grey, 1, cv::LINE_AA);
+	cv::putText(
+		img, "X_L", S(0.3, 0) + cv::Point(4, 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, grey, 1,
+		cv::LINE_AA);
 
 	for (const Cell& c : cells)
 	{
@@ -273,35 +290,53 @@ FigureScales drawUncertaintyFigure(
 		const double b = std::sqrt(kChi2_2dof_95 * std::max(0.0, es.eigenvalues()[0])) * mag * ppm;
 		const Eigen::Vector2d ev = es.eigenvectors().col(1);
 		const double ang_deg = std::atan2(ev.y(), ev.x()) * 180 / M_PI;
-		cv::ellipse(img, p, cv::Size(std::max(1, int(std::lround(a))), std::max(1, int(std::lround(b)))),
+		cv::ellipse(
+			img, p, cv::Size(std::max(1, int(std::lround(a))), std::max(1, int(std::lround(b)))),
 			ang_deg, 0, 360, red, 1, cv::LINE_AA);
 		// Heading: the optical axis (towards the landmark) and a
 		// +-1.96 sigma wedge, magnified like the ellipses (capped at 180 deg).
 		const double th = m.pose_in_landmark[2];
 		const double half = std::min(M_PI, 1.96 * c.u.sigma_heading_rad * hmag);
 		const double len = 0.18 * o.step_m / 0.5;
-		const auto ray = [&](double t) { return S(c.X + len * std::cos(t), c.Y + len * std::sin(t)); };
+		const auto ray = [&](double t)
+		{ return S(c.X + len * std::cos(t), c.Y + len * std::sin(t)); };
 		cv::line(img, p, ray(th - half), blue, 1, cv::LINE_AA);
 		cv::line(img, p, ray(th + half), blue, 1, cv::LINE_AA);
 		cv::line(img, p, ray(th), cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
 		cv::circle(img, p, 2, black, cv::FILLED, cv::LINE_AA);
 		if (std::abs(c.Y) < 1e-9)
-			cv::putText(img, fmt(c.u.sigma_position_m * 1000, 1) + " mm " + fmt(c.u.sigma_heading_rad * 180 / M_PI, 2) + " deg",
+			cv::putText(
+				img,
+				fmt(c.u.sigma_position_m * 1000, 1) + " mm " +
+					fmt(c.u.sigma_heading_rad * 180 / M_PI, 2) + " deg",
 				p + cv::Point(6, 14), cv::FONT_HERSHEY_SIMPLEX, 0.35, black, 1, cv::LINE_AA);
 	}
 
-	const auto text = [&](const std::string& s, int line) {
-		cv::putText(img, s, cv::Point(8, 18 + 17 * line), cv::FONT_HERSHEY_SIMPLEX, 0.42, black, 1, cv::LINE_AA);
+	const auto text = [&](const std::string& s, int line)
+	{
+		cv::putText(
+			img, s, cv::Point(8, 18 + 17 * line), cv::FONT_HERSHEY_SIMPLEX, 0.42, black, 1,
+			cv::LINE_AA);
 	};
-	text("Predicted uncertainty of one landmark fix (paper Fig. 3), top view; robots look at the landmark centre", 0);
-	text("red: 95% position ellipse, drawn x" + fmt(mag, mag < 1 ? 2 : 0) + "; blue: heading +-1.96 sigma, drawn x" +
-			fmt(hmag, 0) + "; grey x: square < " + fmt(o.min_size_px, 0) + " px or out of view", 1);
-	text("sigma_px " + fmt(o.sigma_px, 3) + " per component of P; camera " + std::to_string(camera.width()) + "x" +
-			std::to_string(camera.height()) + ", fx " + fmt(camera.fx(), 1) + " px; landmark scale " + fmt(o.scale, 2) +
-			" (reference square " + fmt(g.inner_size_m * 1000, 0) + " mm)", 2);
+	text(
+		"Predicted uncertainty of one landmark fix (paper Fig. 3), top view; robots look at the "
+		"landmark centre",
+		0);
+	text(
+		"red: 95% position ellipse, drawn x" + fmt(mag, mag < 1 ? 2 : 0) +
+			"; blue: heading +-1.96 sigma, drawn x" + fmt(hmag, 0) + "; grey x: square < " +
+			fmt(o.min_size_px, 0) + " px or out of view",
+		1);
+	text(
+		"sigma_px " + fmt(o.sigma_px, 3) + " per component of P; camera " +
+			std::to_string(camera.width()) + "x" + std::to_string(camera.height()) + ", fx " +
+			fmt(camera.fx(), 1) + " px; landmark scale " + fmt(o.scale, 2) + " (reference square " +
+			fmt(g.inner_size_m * 1000, 0) + " mm)",
+		2);
 	text("labels on the axis: 1-sigma position (worst direction) and heading", 3);
 	text("1 m", 4);
-	cv::line(img, cv::Point(40, 18 + 17 * 4 - 4), cv::Point(40 + int(ppm), 18 + 17 * 4 - 4), black, 2);
+	cv::line(
+		img, cv::Point(40, 18 + 17 * 4 - 4), cv::Point(40 + int(ppm), 18 + 17 * 4 - 4), black, 2);
 	if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
 	return {mag, hmag};
 }

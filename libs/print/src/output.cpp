@@ -22,8 +22,8 @@ namespace
 constexpr double kMmPerInch = 25.4;
 constexpr double kPointsPerInch = 72.0;
 constexpr double kMinDpi = 10, kMaxDpi = 1200;
-constexpr double kMaxPixels = 2e8;  // 800 MB of RGB24 while drawing
-const char* const kFontFamily = "DejaVu Sans";  // Debian's default sans font
+constexpr double kMaxPixels = 2e8;	// 800 MB of RGB24 while drawing
+const char* const kFontFamily = "DejaVu Sans";	// Debian's default sans font
 const char* const kSvgFontFamily = "DejaVu Sans, Arial, Helvetica, sans-serif";
 
 // A length for SVG: 4 decimals (0.1 um), trailing zeros dropped.
@@ -55,11 +55,20 @@ std::string xmlEscape(const std::string& in)
 	{
 		switch (ch)
 		{
-			case '&': out += "&amp;"; break;
-			case '<': out += "&lt;"; break;
-			case '>': out += "&gt;"; break;
-			case '"': out += "&quot;"; break;
-			default: out += ch;
+			case '&':
+				out += "&amp;";
+				break;
+			case '<':
+				out += "&lt;";
+				break;
+			case '>':
+				out += "&gt;";
+				break;
+			case '"':
+				out += "&quot;";
+				break;
+			default:
+				out += ch;
 		}
 	}
 	return out;
@@ -111,8 +120,8 @@ void drawPage(cairo_t* cr, const Page& page)
 std::uint32_t readBe32(const std::string& s, std::size_t at)
 {
 	const auto* p = reinterpret_cast<const unsigned char*>(s.data() + at);
-	return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) |
-		(std::uint32_t(p[2]) << 8) | std::uint32_t(p[3]);
+	return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) |
+		   std::uint32_t(p[3]);
 }
 
 void appendBe32(std::string& s, std::uint32_t v)
@@ -142,12 +151,11 @@ std::string svgDocument(const Page& page)
 	std::ostringstream s;
 	s << "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
 	  << "<!-- codemark landmark(s) at exact size: 1 user unit = 1 mm -->\n"
-	  << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\""
-	  << num(page.width_mm) << "mm\" height=\"" << num(page.height_mm)
-	  << "mm\" viewBox=\"0 0 " << num(page.width_mm) << " " << num(page.height_mm)
-	  << "\">\n";
-	s << "  <rect id=\"page\" x=\"0\" y=\"0\" width=\"" << num(page.width_mm)
-	  << "\" height=\"" << num(page.height_mm) << "\" fill=\"#ffffff\"/>\n";
+	  << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << num(page.width_mm)
+	  << "mm\" height=\"" << num(page.height_mm) << "mm\" viewBox=\"0 0 " << num(page.width_mm)
+	  << " " << num(page.height_mm) << "\">\n";
+	s << "  <rect id=\"page\" x=\"0\" y=\"0\" width=\"" << num(page.width_mm) << "\" height=\""
+	  << num(page.height_mm) << "\" fill=\"#ffffff\"/>\n";
 	for (const FilledRect& r : page.rects)
 		s << "  <rect id=\"" << xmlEscape(r.name) << "\" x=\"" << num(r.x_mm) << "\" y=\""
 		  << num(r.y_mm) << "\" width=\"" << num(r.w_mm) << "\" height=\"" << num(r.h_mm)
@@ -155,8 +163,7 @@ std::string svgDocument(const Page& page)
 	for (const TextLine& t : page.texts)
 		s << "  <text x=\"" << num(t.centre_x_mm) << "\" y=\"" << num(t.baseline_y_mm)
 		  << "\" font-family=\"" << kSvgFontFamily << "\" font-size=\"" << num(t.size_mm)
-		  << "\" text-anchor=\"middle\" fill=\"#000000\">" << xmlEscape(t.text)
-		  << "</text>\n";
+		  << "\" text-anchor=\"middle\" fill=\"#000000\">" << xmlEscape(t.text) << "</text>\n";
 	s << "</svg>\n";
 	return s.str();
 }
@@ -236,8 +243,8 @@ std::string withPngResolution(const std::string& png, double dpi)
 
 	std::string chunk = "pHYs";
 	const auto ppm = static_cast<std::uint32_t>(std::lround(dpi / 0.0254));
-	appendBe32(chunk, ppm);  // pixels per unit, x
-	appendBe32(chunk, ppm);  // pixels per unit, y
+	appendBe32(chunk, ppm);	 // pixels per unit, x
+	appendBe32(chunk, ppm);	 // pixels per unit, y
 	chunk += '\x01';  // unit: metre
 	const auto crc = static_cast<std::uint32_t>(
 		crc32(0L, reinterpret_cast<const Bytef*>(chunk.data()), static_cast<uInt>(chunk.size())));

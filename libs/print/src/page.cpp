@@ -12,7 +12,7 @@ namespace codemark::print
 {
 namespace
 {
-constexpr double kSpecInner_mm = 160.0;  // the spec's reference square at scale 1
+constexpr double kSpecInner_mm = 160.0;	 // the spec's reference square at scale 1
 constexpr double kLabelSizeAtScale1_mm = 3.5;  // about 10 pt
 constexpr double kLabelMinSize_mm = 1.5;  // about 4 pt, still legible
 // Average advance of the label's characters in DejaVu Sans / Arial, in em,
@@ -37,7 +37,7 @@ std::string shortNumber(double v, int decimals, int keep)
 	if (dot == std::string::npos) return s;
 	std::size_t end = s.size();
 	while (end > dot + 1 + static_cast<std::size_t>(keep) && s[end - 1] == '0') --end;
-	if (end == dot + 1) --end;  // no decimals left: drop the point
+	if (end == dot + 1) --end;	// no decimals left: drop the point
 	return s.substr(0, end);
 }
 }  // namespace
@@ -46,8 +46,7 @@ std::string labelText(const LandmarkGeometry& geometry, int id)
 {
 	std::ostringstream s;
 	s << "codemark ID " << id << " (scale " << shortNumber(scaleOf(geometry), 3, 1)
-	  << ", reference square " << shortNumber(geometry.inner_size_m * 1e3, 1, 0)
-	  << " mm)";
+	  << ", reference square " << shortNumber(geometry.inner_size_m * 1e3, 1, 0) << " mm)";
 	return s.str();
 }
 
@@ -96,7 +95,7 @@ Placement appendLandmark(
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)
 		{
-			if (!cells[r][c]) continue;  // green: the fill shows through
+			if (!cells[r][c]) continue;	 // green: the fill shows through
 			const Eigen::Vector2d st = g.cellCentreFace(r, c);
 			page.rects.push_back(
 				{prefix + "cell-r" + std::to_string(r) + "c" + std::to_string(c),
@@ -139,8 +138,8 @@ std::vector<double> fitAxis(double length, double block, double gap, double lo, 
 
 struct Grid
 {
-	std::vector<double> ink_x;  // left edge of each column's ink [mm]
-	std::vector<double> ink_y;  // top edge of each row's ink (the frame's top) [mm]
+	std::vector<double> ink_x;	// left edge of each column's ink [mm]
+	std::vector<double> ink_y;	// top edge of each row's ink (the frame's top) [mm]
 };
 
 Grid gridOnA4(const LandmarkExtent& e, double border)
@@ -155,8 +154,8 @@ Grid gridOnA4(const LandmarkExtent& e, double border)
 	// band the border; between rows one quiet margin above the next frame.
 	Grid g;
 	g.ink_x = fitAxis(kA4Width_mm, e.width_mm, e.margin_mm, edge_x, edge_x);
-	g.ink_y = fitAxis(
-		kA4Height_mm, e.height_mm, e.margin_mm, std::max(e.margin_mm, border), border);
+	g.ink_y =
+		fitAxis(kA4Height_mm, e.height_mm, e.margin_mm, std::max(e.margin_mm, border), border);
 	return g;
 }
 
@@ -192,7 +191,8 @@ std::vector<Page> sheetPages(
 		  << " mm frame does not fit on A4 (210 x 297 mm) with a "
 		  << shortNumber(paper_border_mm, 1, 0) << " mm paper border: it needs "
 		  << shortNumber(std::max(need, e.width_mm + 2 * paper_border_mm), 1, 0) << " x "
-		  << shortNumber(e.height_mm + std::max(e.margin_mm, paper_border_mm) + paper_border_mm, 1, 0)
+		  << shortNumber(
+				 e.height_mm + std::max(e.margin_mm, paper_border_mm) + paper_border_mm, 1, 0)
 		  << " mm; use a smaller --scale or --border, or print without --sheet";
 		throw std::invalid_argument(s.str());
 	}

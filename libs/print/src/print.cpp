@@ -61,9 +61,12 @@ std::string formatName(Format f)
 {
 	switch (f)
 	{
-		case Format::Svg: return "svg";
-		case Format::Png: return "png";
-		case Format::Pdf: return "pdf";
+		case Format::Svg:
+			return "svg";
+		case Format::Png:
+			return "png";
+		case Format::Pdf:
+			return "pdf";
 	}
 	return "?";
 }
@@ -109,8 +112,7 @@ void parseIds(const std::string& arg, std::vector<int>& ids)
 				throw std::invalid_argument(
 					"ID range '" + item + "' runs backwards (write the smaller ID first)");
 			if (b > 255)
-				throw std::invalid_argument(
-					"landmark ID range '" + item + "' goes outside 0..255");
+				throw std::invalid_argument("landmark ID range '" + item + "' goes outside 0..255");
 			for (int id = a; id <= b; ++id) ids.push_back(id);
 		}
 		else
@@ -143,7 +145,7 @@ LandmarkGeometry geometryOf(const PrintOptions& o)
 		}
 		catch (const std::exception&)
 		{
-			rethrowNamingIniFile(path);  // one line, with the line of a bad number
+			rethrowNamingIniFile(path);	 // one line, with the line of a bad number
 		}
 	}
 	g.outer_size_m *= o.scale;
@@ -161,13 +163,13 @@ void validate(const PrintOptions& o)
 	for (int id : o.ids)
 	{
 		if (id < 0 || id > 255)
-			throw std::invalid_argument(
-				"landmark ID " + std::to_string(id) + " is outside 0..255");
+			throw std::invalid_argument("landmark ID " + std::to_string(id) + " is outside 0..255");
 		if (!seen.insert(id).second)
 			throw std::invalid_argument(
 				"landmark ID " + std::to_string(id) + " is given more than once");
 	}
-	if (o.formats.empty()) throw std::invalid_argument("no output format given (give e.g. svg,png,pdf)");
+	if (o.formats.empty())
+		throw std::invalid_argument("no output format given (give e.g. svg,png,pdf)");
 	if (o.out_dir.empty()) throw std::invalid_argument("no output folder given (use --out DIR)");
 	const LandmarkGeometry g = geometryOf(o);
 	// The largest page decides whether the PNG can be drawn.
@@ -175,7 +177,7 @@ void validate(const PrintOptions& o)
 	if (o.sheet)
 	{
 		if (landmarksPerSheet(g, o.paper_border_mm) < 1)
-			sheetPages(g, {o.ids.front()}, o.paper_border_mm);  // throws the why
+			sheetPages(g, {o.ids.front()}, o.paper_border_mm);	// throws the why
 		largest.width_mm = kA4Width_mm;
 		largest.height_mm = kA4Height_mm;
 	}
@@ -184,7 +186,7 @@ void validate(const PrintOptions& o)
 	if (std::find(o.formats.begin(), o.formats.end(), Format::Png) != o.formats.end())
 		checkPngRaster(largest, o.dpi);
 	else if (!std::isfinite(o.dpi) || o.dpi < 10 || o.dpi > 1200)
-		checkPngRaster(largest, o.dpi);  // a bad --dpi is an error even without PNG
+		checkPngRaster(largest, o.dpi);	 // a bad --dpi is an error even without PNG
 }
 
 PrintReport run(const PrintOptions& o, std::ostream* log)
@@ -199,8 +201,8 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 	fs::create_directories(dir, ec);
 	if (ec || !fs::is_directory(dir))
 		throw std::runtime_error(
-			"cannot create output folder '" + o.out_dir + "': " +
-			(ec ? ec.message() : std::string("not a folder")));
+			"cannot create output folder '" + o.out_dir +
+			"': " + (ec ? ec.message() : std::string("not a folder")));
 	{
 		const fs::path probe = dir / ".codemark-print-write-test";
 		std::ofstream f(probe);
@@ -217,9 +219,8 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 			*log << "wrote " << p.string() << " (" << page.width_mm << " x " << page.height_mm
 				 << " mm)\n";
 	};
-	auto has = [&](Format f) {
-		return std::find(o.formats.begin(), o.formats.end(), f) != o.formats.end();
-	};
+	auto has = [&](Format f)
+	{ return std::find(o.formats.begin(), o.formats.end(), f) != o.formats.end(); };
 
 	if (log)
 		*log << "landmark: outer frame " << sizeMm(g.outer_size_m) << " mm, reference square "
@@ -236,9 +237,15 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 				const fs::path p = dir / ("codemark-" + std::to_string(id) + "." + formatName(f));
 				switch (f)
 				{
-					case Format::Svg: writeSvg(page, p.string()); break;
-					case Format::Png: writePng(page, p.string(), o.dpi); break;
-					case Format::Pdf: writePdf({page}, p.string()); break;
+					case Format::Svg:
+						writeSvg(page, p.string());
+						break;
+					case Format::Png:
+						writePng(page, p.string(), o.dpi);
+						break;
+					case Format::Pdf:
+						writePdf({page}, p.string());
+						break;
 				}
 				wrote(p, page);
 			}
@@ -250,8 +257,7 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 	const std::vector<Page> pages = sheetPages(g, o.ids, o.paper_border_mm);
 	report.pages = static_cast<int>(pages.size());
 	if (log)
-		*log << "sheet: " << landmarksPerSheet(g, o.paper_border_mm)
-			 << " landmark(s) per A4 page, "
+		*log << "sheet: " << landmarksPerSheet(g, o.paper_border_mm) << " landmark(s) per A4 page, "
 			 << pages.size() << " page(s)\n";
 	if (has(Format::Pdf))
 	{

@@ -24,7 +24,8 @@ namespace
  * spacing, low-pass filtered there (Gaussian, 2 grid steps) and resampled
  * bicubically to \a grid. Filtering before upsampling keeps the bicubic
  * grid pattern invisible and costs little. */
-cv::Mat smoothField(cv::RNG& rng, int width, int height, double cell_px, int channels, const cv::Size& grid)
+cv::Mat smoothField(
+	cv::RNG& rng, int width, int height, double cell_px, int channels, const cv::Size& grid)
 {
 	const double step = std::max(1.0, cell_px / 4);
 	const int gw = std::max(4, static_cast<int>(std::ceil(width / step)) + 1);
@@ -33,7 +34,7 @@ cv::Mat smoothField(cv::RNG& rng, int width, int height, double cell_px, int cha
 	rng.fill(g, cv::RNG::NORMAL, 0.0, 1.0);
 	constexpr double sigma = 2.0;
 	cv::GaussianBlur(g, g, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
-	g *= 2 * std::sqrt(CV_PI) * sigma;  // the blur divides the variance by 4 pi sigma^2
+	g *= 2 * std::sqrt(CV_PI) * sigma;	// the blur divides the variance by 4 pi sigma^2
 	if (g.size() == grid) return g;
 	cv::Mat out;
 	cv::resize(g, out, grid, 0, 0, cv::INTER_CUBIC);
@@ -56,7 +57,8 @@ struct LocalFrame
 	}
 
 	/** Fills the local axis-aligned rectangle [x0, x1] x [y0, y1]. */
-	void rect(cv::Mat& img, double x0, double y0, double x1, double y1, const cv::Scalar& colour) const
+	void rect(
+		cv::Mat& img, double x0, double y0, double x1, double y1, const cv::Scalar& colour) const
 	{
 		const std::array<cv::Point, 4> p{
 			toImage(x0, y0), toImage(x1, y0), toImage(x1, y1), toImage(x0, y1)};
@@ -67,7 +69,8 @@ struct LocalFrame
 cv::Scalar jitter(cv::RNG& rng, const cv::Scalar& c, double amount)
 {
 	cv::Scalar out;
-	for (int i = 0; i < 3; ++i) out[i] = std::clamp(c[i] + rng.uniform(-amount, amount), 0.0, 255.0);
+	for (int i = 0; i < 3; ++i)
+		out[i] = std::clamp(c[i] + rng.uniform(-amount, amount), 0.0, 255.0);
 	return out;
 }
 
@@ -84,27 +87,30 @@ void drawDistractor(cv::Mat& img, cv::RNG& rng, const RenderOptions& o)
 	const cv::Scalar black = jitter(rng, o.black_bgr, 10);
 	switch (rng.uniform(0, 5))
 	{
-		case 0:  // a green blob (no frame)
+		case 0:	 // a green blob (no frame)
 		{
 			cv::ellipse(
-				img, cv::Point(f.toImage(0, 0)), cv::Size(static_cast<int>(a * 16), static_cast<int>(b * 16)),
+				img, cv::Point(f.toImage(0, 0)),
+				cv::Size(static_cast<int>(a * 16), static_cast<int>(b * 16)),
 				f.angle_rad * 180 / CV_PI, 0, 360, green, cv::FILLED, cv::LINE_AA, 4);
 			break;
 		}
-		case 1:  // a green rectangle without a frame
+		case 1:	 // a green rectangle without a frame
 			f.rect(img, -a, -b, a, b, green);
 			break;
-		case 2:  // a black frame filled with another colour
+		case 2:	 // a black frame filled with another colour
 		{
 			static const std::array<cv::Scalar, 4> fills{
-				cv::Scalar(30, 30, 200), cv::Scalar(200, 40, 30), o.white_bgr, cv::Scalar(128, 128, 128)};
+				cv::Scalar(30, 30, 200), cv::Scalar(200, 40, 30), o.white_bgr,
+				cv::Scalar(128, 128, 128)};
 			const double t = rng.uniform(0.1, 0.25);
 			f.rect(img, -a, -a, a, a, black);
-			f.rect(img, -a * (1 - t), -a * (1 - t), a * (1 - t), a * (1 - t),
-				   jitter(rng, fills[rng.uniform(0, 4)], 15));
+			f.rect(
+				img, -a * (1 - t), -a * (1 - t), a * (1 - t), a * (1 - t),
+				jitter(rng, fills[rng.uniform(0, 4)], 15));
 			break;
 		}
-		case 3:  // a poster: light sheet with black text lines and green print
+		case 3:	 // a poster: light sheet with black text lines and green print
 		{
 			f.rect(img, -a, -b, a, b, jitter(rng, o.white_bgr, 20));
 			const int lines = rng.uniform(3, 9);
@@ -127,8 +133,9 @@ void drawDistractor(cv::Mat& img, cv::RNG& rng, const RenderOptions& o)
 			for (int r = 0; r < n; ++r)
 				for (int c = 0; c < n; ++c)
 					if (rng.uniform(0, 2))
-						f.rect(img, -a + (c + 1) * cell, -a + (r + 1) * cell, -a + (c + 2) * cell,
-							   -a + (r + 2) * cell, o.white_bgr);
+						f.rect(
+							img, -a + (c + 1) * cell, -a + (r + 1) * cell, -a + (c + 2) * cell,
+							-a + (r + 2) * cell, o.white_bgr);
 			break;
 		}
 	}
@@ -138,7 +145,8 @@ void drawDistractor(cv::Mat& img, cv::RNG& rng, const RenderOptions& o)
 cv::Mat makeBackground(const RenderOptions& o, int width, int height, uint64_t seed)
 {
 	const double g = o.background_grey;
-	if (o.background == Background::Flat) return cv::Mat(height, width, CV_32FC3, cv::Scalar(g, g, g));
+	if (o.background == Background::Flat)
+		return cv::Mat(height, width, CV_32FC3, cv::Scalar(g, g, g));
 
 	// A wall: smooth luminance at two scales plus a faint colour tint,
 	// summed on the finest field's grid (3 px) and upsampled once.

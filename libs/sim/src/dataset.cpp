@@ -26,7 +26,7 @@ using mrpt::poses::CPose3D;
 mrpt::poses::CPose3D DatasetOptions::cameraPoseOnRobot() const
 {
 	return CPose3D(camera_x_m, camera_y_m, camera_z_m, camera_yaw_deg * M_PI / 180.0, 0, 0) +
-		CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
 RenderOptions DatasetOptions::realisticRender()
@@ -96,14 +96,16 @@ void DatasetOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	g.a3 = c.read_double("odometry", "gaussian_alpha_3", g.a3);
 	g.a4 = c.read_double("odometry", "gaussian_alpha_4", g.a4);
 	g.minStdXY = c.read_double("odometry", "gaussian_min_std_xy", g.minStdXY);
-	g.minStdPHI = c.read_double("odometry", "gaussian_min_std_phi_deg", g.minStdPHI * 180 / M_PI) * M_PI / 180;
+	g.minStdPHI = c.read_double("odometry", "gaussian_min_std_phi_deg", g.minStdPHI * 180 / M_PI) *
+				  M_PI / 180;
 	auto& t = motion.thrunModel;
 	t.alfa1_rot_rot = c.read_float("odometry", "thrun_alfa1_rot_rot", t.alfa1_rot_rot);
 	t.alfa2_rot_trans = c.read_float("odometry", "thrun_alfa2_rot_trans", t.alfa2_rot_trans);
 	t.alfa3_trans_trans = c.read_float("odometry", "thrun_alfa3_trans_trans", t.alfa3_trans_trans);
 	t.alfa4_trans_rot = c.read_float("odometry", "thrun_alfa4_trans_rot", t.alfa4_trans_rot);
 	t.additional_std_XY = c.read_float("odometry", "thrun_additional_std_xy", t.additional_std_XY);
-	t.additional_std_phi = c.read_float("odometry", "thrun_additional_std_phi", t.additional_std_phi);
+	t.additional_std_phi =
+		c.read_float("odometry", "thrun_additional_std_phi", t.additional_std_phi);
 	MRPT_LOAD_CONFIG_VAR(odometry_scale_error, double, c, "odometry");
 
 	camera_file = c.read_string("camera", "camera_file", camera_file);
@@ -115,15 +117,23 @@ void DatasetOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 
 	if (c.sectionExists("render")) render.loadFromConfigFile(c, "render");
 
-	require(room_width_m > 0 && room_depth_m > 0, "[map] room_width_m and room_depth_m must be > 0");
-	require(room_landmarks >= 0 && first_id >= 0 && first_id + room_landmarks <= 256,
+	require(
+		room_width_m > 0 && room_depth_m > 0, "[map] room_width_m and room_depth_m must be > 0");
+	require(
+		room_landmarks >= 0 && first_id >= 0 && first_id + room_landmarks <= 256,
 		"[map] first_id + room_landmarks must stay within the 256 IDs");
 	require(speed_mps > 0, "[trajectory] speed_mps must be > 0");
 	require(loops >= 1, "[trajectory] loops must be >= 1");
-	require(loop_margin_m > 0 && corner_radius_m > 0, "[trajectory] loop_margin_m and corner_radius_m must be > 0");
+	require(
+		loop_margin_m > 0 && corner_radius_m > 0,
+		"[trajectory] loop_margin_m and corner_radius_m must be > 0");
 	require(frame_rate_hz > 0 && odometry_rate_hz > 0, "[dataset] rates must be > 0");
-	require(std::isfinite(start_time) && start_time >= 0, "[dataset] start_time must be a UNIX time >= 0");
-	require(std::abs(odometry_scale_error) < 0.5, "[odometry] odometry_scale_error must be within +-0.5");
+	require(
+		std::isfinite(start_time) && start_time >= 0,
+		"[dataset] start_time must be a UNIX time >= 0");
+	require(
+		std::abs(odometry_scale_error) < 0.5,
+		"[odometry] odometry_scale_error must be within +-0.5");
 	require(!sensor_label.empty(), "[camera] sensor_label must not be empty");
 }
 
@@ -144,8 +154,10 @@ void DatasetOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write("dataset", "odometry_rate_hz", odometry_rate_hz);
 	c.write("dataset", "start_time", start_time);
 	c.write("dataset", "seed", static_cast<uint64_t>(seed));
-	c.write("odometry", "motion_model",
-		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "gaussian" : "thrun");
+	c.write(
+		"odometry", "motion_model",
+		motion.modelSelection == mrpt::obs::CActionRobotMovement2D::mmGaussian ? "gaussian"
+																			   : "thrun");
 	c.write("odometry", "gaussian_alpha_1", motion.gaussianModel.a1);
 	c.write("odometry", "gaussian_alpha_2", motion.gaussianModel.a2);
 	c.write("odometry", "gaussian_alpha_3", motion.gaussianModel.a3);
@@ -175,11 +187,11 @@ LandmarkMap generateRoomMap(const DatasetOptions& o)
 		l.z_m = o.landmark_height_m;
 		if (s < W)
 		{
-			l.x_m = s, l.y_m = 0, l.yaw_rad = M_PI / 2;  // wall y = 0 faces +y
+			l.x_m = s, l.y_m = 0, l.yaw_rad = M_PI / 2;	 // wall y = 0 faces +y
 		}
 		else if ((s -= W) < D)
 		{
-			l.x_m = W, l.y_m = s, l.yaw_rad = M_PI;  // wall x = W faces -x
+			l.x_m = W, l.y_m = s, l.yaw_rad = M_PI;	 // wall x = W faces -x
 		}
 		else if ((s -= D) < W)
 		{
@@ -213,14 +225,10 @@ std::vector<Piece> loopPieces(const DatasetOptions& o)
 			"dataset options: the loop does not fit: the room minus twice loop_margin_m must be at "
 			"least twice corner_radius_m in both directions");
 	const double q = M_PI / 2 * r;
-	return {{x0 + r, y0, 0, a - 2 * r, 0},
-			{x1 - r, y0, 0, q, 1 / r},
-			{x1, y0 + r, M_PI / 2, b - 2 * r, 0},
-			{x1, y1 - r, M_PI / 2, q, 1 / r},
-			{x1 - r, y1, M_PI, a - 2 * r, 0},
-			{x0 + r, y1, M_PI, q, 1 / r},
-			{x0, y1 - r, -M_PI / 2, b - 2 * r, 0},
-			{x0, y0 + r, -M_PI / 2, q, 1 / r}};
+	return {{x0 + r, y0, 0, a - 2 * r, 0},		   {x1 - r, y0, 0, q, 1 / r},
+			{x1, y0 + r, M_PI / 2, b - 2 * r, 0},  {x1, y1 - r, M_PI / 2, q, 1 / r},
+			{x1 - r, y1, M_PI, a - 2 * r, 0},	   {x0 + r, y1, M_PI, q, 1 / r},
+			{x0, y1 - r, -M_PI / 2, b - 2 * r, 0}, {x0, y0 + r, -M_PI / 2, q, 1 / r}};
 }
 
 CPose2D poseOnPiece(const Piece& p, double s)
@@ -295,8 +303,8 @@ class Trajectory
 		const auto &a = keys_[i], &b = keys_[i + 1];
 		const double u = std::clamp((ta - a.t) / (b.t - a.t), 0.0, 1.0);
 		const double dyaw = mrpt::math::wrapToPi(b.pose.phi() - a.pose.phi());
-		return CPose2D(a.pose.x() + u * (b.pose.x() - a.pose.x()),
-			a.pose.y() + u * (b.pose.y() - a.pose.y()),
+		return CPose2D(
+			a.pose.x() + u * (b.pose.x() - a.pose.x()), a.pose.y() + u * (b.pose.y() - a.pose.y()),
 			mrpt::math::wrapToPi(a.pose.phi() + u * dyaw));
 	}
 
@@ -382,7 +390,8 @@ DatasetSummary writeDataset(
 	mrpt::random::getRandomGenerator().randomize(o.seed);
 	const Trajectory trajectory(o);
 	auto frames = trajectory.sample(o.frame_rate_hz, 0.0);
-	if (max_frames > 0 && frames.size() > static_cast<std::size_t>(max_frames)) frames.resize(max_frames);
+	if (max_frames > 0 && frames.size() > static_cast<std::size_t>(max_frames))
+		frames.resize(max_frames);
 	// Observations-only: odometry at its own rate, offset by half a period so
 	// that it never coincides with an image: filters must interpolate.
 	std::vector<TimedPose2D> odo_truth;
@@ -403,7 +412,7 @@ DatasetSummary writeDataset(
 	gt << "# timestamp[UNIX s] x[m] y[m] yaw[rad]: the robot's true pose at each image\n";
 	gt << std::fixed;
 
-	CPose2D odo_accum(0, 0, 0);  // the odometry's own integrated pose
+	CPose2D odo_accum(0, 0, 0);	 // the odometry's own integrated pose
 	CPose2D prev_truth = frames.front().pose;
 	std::size_t next_odo = 0;
 	const int total = static_cast<int>(frames.size());
@@ -454,7 +463,8 @@ DatasetSummary writeDataset(
 		obs->cameraPose = cam_on_robot;
 		obs->cameraParams = camera.params();
 		obs->image.setExternalStorage(name.str());
-		if (obs_only) ar << *obs;
+		if (obs_only)
+			ar << *obs;
 		else
 		{
 			mrpt::obs::CSensoryFrame sf;

@@ -36,9 +36,12 @@ std::vector<mrpt::poses::CPose3D> viewpointsAroundLandmarks(
 	const LandmarkMap& map, int count, uint64_t seed, const ViewpointOptions& vp)
 {
 	if (map.landmarks.empty()) throw std::invalid_argument("viewpoints: the map has no landmarks");
-	if (!(vp.min_distance_m > 0 && vp.max_distance_m >= vp.min_distance_m && vp.max_view_angle_rad >= 0 &&
-		  vp.max_view_angle_rad < M_PI / 2 && vp.max_bearing_rad >= 0))
-		throw std::invalid_argument("viewpoints: need 0 < min_distance <= max_distance, 0 <= view angle < 90 deg, bearing >= 0");
+	if (!(vp.min_distance_m > 0 && vp.max_distance_m >= vp.min_distance_m &&
+		  vp.max_view_angle_rad >= 0 && vp.max_view_angle_rad < M_PI / 2 &&
+		  vp.max_bearing_rad >= 0))
+		throw std::invalid_argument(
+			"viewpoints: need 0 < min_distance <= max_distance, 0 <= view angle < 90 deg, bearing "
+			">= 0");
 	cv::RNG rng(detail::streamSeed(seed, 100));
 	std::vector<mrpt::poses::CPose3D> poses;
 	poses.reserve(count);
@@ -65,10 +68,12 @@ std::vector<mrpt::poses::CPose3D> loadCameraPoses(const std::string& path)
 		if (v.empty()) continue;
 		if (v.size() != 6)
 			throw std::runtime_error(
-				path + ":" + std::to_string(n) + ": expected 6 fields 'x y z yaw pitch roll' (m, deg), got " +
+				path + ":" + std::to_string(n) +
+				": expected 6 fields 'x y z yaw pitch roll' (m, deg), got " +
 				std::to_string(v.size()));
 		const double k = M_PI / 180;
-		poses.push_back(opticalFromBody(mrpt::poses::CPose3D(v[0], v[1], v[2], v[3] * k, v[4] * k, v[5] * k)));
+		poses.push_back(
+			opticalFromBody(mrpt::poses::CPose3D(v[0], v[1], v[2], v[3] * k, v[4] * k, v[5] * k)));
 	}
 	if (poses.empty()) throw std::runtime_error(path + ": no camera poses in file");
 	return poses;
@@ -97,10 +102,12 @@ std::string jsonString(const std::string& s)
 	o << '"';
 	for (char c : s)
 	{
-		if (c == '"' || c == '\\') o << '\\' << c;
+		if (c == '"' || c == '\\')
+			o << '\\' << c;
 		else if (static_cast<unsigned char>(c) < 0x20)
 			o << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-		else o << c;
+		else
+			o << c;
 	}
 	o << '"';
 	return o.str();
@@ -132,15 +139,17 @@ std::string frameTruthJson(
 		if (!isInView(t, cam)) continue;
 		o << (first ? "" : ", ") << "{\"id\": " << t.id << ", \"corners\": [";
 		for (int i = 0; i < 4; ++i)
-			o << (i ? ", " : "") << '[' << t.corners_px[i].x() << ", " << t.corners_px[i].y() << ']';
+			o << (i ? ", " : "") << '[' << t.corners_px[i].x() << ", " << t.corners_px[i].y()
+			  << ']';
 		o << "], \"P\": ";
 		jsonArray(o, t.P, 4);
 		o << ", \"L\": ";
 		jsonArray(o, t.sighting.L, 3);
 		o << ", \"pose_in_landmark\": ";
 		jsonArray(o, t.sighting.pose_in_landmark, 3);
-		o << ", \"fully_visible\": " << (t.fully_visible ? "true" : "false") << ", \"area_px\": " << t.area_px
-		  << ", \"occluded_fraction\": " << t.occluded_fraction << '}';
+		o << ", \"fully_visible\": " << (t.fully_visible ? "true" : "false")
+		  << ", \"area_px\": " << t.area_px << ", \"occluded_fraction\": " << t.occluded_fraction
+		  << '}';
 		first = false;
 	}
 	o << "]}";

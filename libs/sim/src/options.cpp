@@ -39,11 +39,13 @@ cv::Scalar readBgr(
 	const std::string text = c.read_string(s, key, "");
 	if (text.empty()) return def;
 	std::string t = text;
-	std::replace_if(t.begin(), t.end(), [](char ch) { return ch == '[' || ch == ']' || ch == ','; }, ' ');
+	std::replace_if(
+		t.begin(), t.end(), [](char ch) { return ch == '[' || ch == ']' || ch == ','; }, ' ');
 	std::istringstream in(t);
 	double b, g, r;
 	std::string rest;
-	if (!(in >> b >> g >> r) || (in >> rest)) bad(key, "must be three numbers \"B G R\", got '" + text + "'");
+	if (!(in >> b >> g >> r) || (in >> rest))
+		bad(key, "must be three numbers \"B G R\", got '" + text + "'");
 	return {b, g, r};
 }
 
@@ -59,9 +61,12 @@ const char* backgroundName(Background b)
 {
 	switch (b)
 	{
-		case Background::Flat: return "Flat";
-		case Background::Textured: return "Textured";
-		case Background::Cluttered: return "Cluttered";
+		case Background::Flat:
+			return "Flat";
+		case Background::Textured:
+			return "Textured";
+		case Background::Cluttered:
+			return "Cluttered";
 	}
 	return "Flat";
 }
@@ -69,7 +74,8 @@ const char* backgroundName(Background b)
 Background backgroundFromName(const std::string& name)
 {
 	std::string n = name;
-	std::transform(n.begin(), n.end(), n.begin(), [](unsigned char ch) { return std::tolower(ch); });
+	std::transform(
+		n.begin(), n.end(), n.begin(), [](unsigned char ch) { return std::tolower(ch); });
 	if (n == "flat") return Background::Flat;
 	if (n == "textured") return Background::Textured;
 	if (n == "cluttered") return Background::Cluttered;
@@ -99,8 +105,7 @@ void RenderOptions::validate() const
 		bad("supersampling", "must be in 1..64, got " + std::to_string(supersampling));
 }
 
-void RenderOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+void RenderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	// MRPT's readers take "abc" as 0 and "2px" as 2: check the numbers first.
 	requireIniNumbers(
@@ -127,25 +132,36 @@ void RenderOptions::loadFromConfigFile(
 	validate();
 }
 
-void RenderOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void RenderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "background", std::string(backgroundName(background)), -1, -1, "Flat, Textured or Cluttered");
-	c.write(s, "background_grey", background_grey, -1, -1, "flat background level / texture mean [0..255]");
+	c.write(
+		s, "background", std::string(backgroundName(background)), -1, -1,
+		"Flat, Textured or Cluttered");
+	c.write(
+		s, "background_grey", background_grey, -1, -1,
+		"flat background level / texture mean [0..255]");
 	c.write(s, "distractors", distractors, -1, -1, "number of distractor shapes (Cluttered only)");
 	c.write(s, "black_bgr", bgrText(black_bgr), -1, -1, "printed black at gain 1, B G R [0..255]");
 	c.write(s, "white_bgr", bgrText(white_bgr), -1, -1, "sheet white at gain 1, B G R [0..255]");
-	c.write(s, "green_bgr", bgrText(green_bgr), -1, -1, "fluorescent green at gain 1, B G R [0..255]");
+	c.write(
+		s, "green_bgr", bgrText(green_bgr), -1, -1, "fluorescent green at gain 1, B G R [0..255]");
 	c.write(s, "gain", gain, -1, -1, "illumination gain (> 0)");
 	c.write(s, "gradient", gradient, -1, -1, "relative gain change across the image (0.5: +-25%)");
-	c.write(s, "gradient_angle_rad", gradient_angle_rad, -1, -1, "direction of the gradient in the image [rad]");
+	c.write(
+		s, "gradient_angle_rad", gradient_angle_rad, -1, -1,
+		"direction of the gradient in the image [rad]");
 	c.write(s, "noise_sigma", noise_sigma, -1, -1, "Gaussian pixel noise [grey levels]");
 	c.write(s, "blur_sigma_px", blur_sigma_px, -1, -1, "Gaussian blur sigma [px]");
 	c.write(s, "motion_blur_px", motion_blur_px, -1, -1, "linear motion blur length [px]");
-	c.write(s, "motion_blur_angle_rad", motion_blur_angle_rad, -1, -1, "motion direction, counter-clockwise from +u [rad]");
+	c.write(
+		s, "motion_blur_angle_rad", motion_blur_angle_rad, -1, -1,
+		"motion direction, counter-clockwise from +u [rad]");
 	c.write(s, "jpeg_quality", jpeg_quality, -1, -1, "0 = no JPEG round trip, else 1..100");
-	c.write(s, "occlusion", occlusion, -1, -1, "fraction of each reference square hidden by a grey bar [0..1]");
-	c.write(s, "supersampling", supersampling, -1, -1, "samples per pixel side with lens distortion");
+	c.write(
+		s, "occlusion", occlusion, -1, -1,
+		"fraction of each reference square hidden by a grey bar [0..1]");
+	c.write(
+		s, "supersampling", supersampling, -1, -1, "samples per pixel side with lens distortion");
 }
 
 }  // namespace codemark::sim

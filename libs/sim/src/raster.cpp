@@ -59,7 +59,8 @@ double pixelCoverage(const Polygon2& poly, double u, double v)
 {
 	const int n = static_cast<int>(poly.size());
 	if (n < 3) return 0.0;
-	if (n + 8 > kMaxVertices) throw std::invalid_argument("pixelCoverage: polygon has too many vertices");
+	if (n + 8 > kMaxVertices)
+		throw std::invalid_argument("pixelCoverage: polygon has too many vertices");
 	// Pixel-local coordinates keep the clipped area free of cancellation.
 	Buffer a, b;
 	for (int i = 0; i < n; ++i) a[i] = poly[i] - Eigen::Vector2d(u, v);

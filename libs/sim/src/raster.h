@@ -45,8 +45,7 @@ Polygon3 clipNear(const Polygon3& poly, double z_min);
 
 /** Pinhole projection (no distortion) of points with z > 0:
  * (fx x/z + cx, fy y/z + cy). */
-Polygon2 projectPinhole(
-	const Polygon3& poly, double fx, double fy, double cx, double cy);
+Polygon2 projectPinhole(const Polygon3& poly, double fx, double fy, double cx, double cy);
 
 /** A rigid transform as Eigen, for transforming many points: p_a = R p_b + t
  * for a_T_b. */
@@ -69,7 +68,8 @@ inline Rigid toRigid(const mrpt::poses::CPose3D& pose)
 
 /** Pixel rectangle (inclusive) of the image that a set of points touches,
  * grown by \a grow px; empty when outside. */
-inline cv::Rect pixelBounds(const std::vector<Eigen::Vector2d>& pts, int width, int height, int grow)
+inline cv::Rect pixelBounds(
+	const std::vector<Eigen::Vector2d>& pts, int width, int height, int grow)
 {
 	double minx = 1e300, maxx = -1e300, miny = 1e300, maxy = -1e300;
 	for (const auto& p : pts)

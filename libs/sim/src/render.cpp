@@ -68,16 +68,25 @@ struct Face
 		const double far = 1.3 * sheet_half, h = inner_half, edge = -h + 2 * h * fraction;
 		switch (side)
 		{
-			case 0: occ_s0 = -far, occ_s1 = edge, occ_t0 = -far, occ_t1 = far; break;
-			case 1: occ_s0 = -edge, occ_s1 = far, occ_t0 = -far, occ_t1 = far; break;
-			case 2: occ_s0 = -far, occ_s1 = far, occ_t0 = -far, occ_t1 = edge; break;
-			default: occ_s0 = -far, occ_s1 = far, occ_t0 = -edge, occ_t1 = far; break;
+			case 0:
+				occ_s0 = -far, occ_s1 = edge, occ_t0 = -far, occ_t1 = far;
+				break;
+			case 1:
+				occ_s0 = -edge, occ_s1 = far, occ_t0 = -far, occ_t1 = far;
+				break;
+			case 2:
+				occ_s0 = -far, occ_s1 = far, occ_t0 = -far, occ_t1 = edge;
+				break;
+			default:
+				occ_s0 = -far, occ_s1 = far, occ_t0 = -edge, occ_t1 = far;
+				break;
 		}
 	}
 
 	Paint paintAt(double s, double t) const
 	{
-		if (has_occluder && s >= occ_s0 && s <= occ_s1 && t >= occ_t0 && t <= occ_t1) return kOccluder;
+		if (has_occluder && s >= occ_s0 && s <= occ_s1 && t >= occ_t0 && t <= occ_t1)
+			return kOccluder;
 		const double m = std::max(std::abs(s), std::abs(t));
 		if (m > sheet_half) return kBackground;
 		if (m > outer_half) return kWhite;
@@ -92,10 +101,11 @@ struct Face
 /** The face rectangle [s0, s1] x [t0, t1] in the camera frame. */
 Polygon3 faceRect(const Rigid& cam_T_lm, double s0, double t0, double s1, double t1)
 {
-	return {cam_T_lm * LandmarkGeometry::faceToLandmark(s0, t0),
-			cam_T_lm * LandmarkGeometry::faceToLandmark(s1, t0),
-			cam_T_lm * LandmarkGeometry::faceToLandmark(s1, t1),
-			cam_T_lm * LandmarkGeometry::faceToLandmark(s0, t1)};
+	return {
+		cam_T_lm * LandmarkGeometry::faceToLandmark(s0, t0),
+		cam_T_lm * LandmarkGeometry::faceToLandmark(s1, t0),
+		cam_T_lm * LandmarkGeometry::faceToLandmark(s1, t1),
+		cam_T_lm * LandmarkGeometry::faceToLandmark(s0, t1)};
 }
 
 Polygon3 faceSquare(const Rigid& cam_T_lm, double half)
@@ -108,8 +118,9 @@ using detail::pixelBounds;
 std::array<cv::Vec3d, kNumPaints> paintColours(const RenderOptions& o)
 {
 	const auto v = [](const cv::Scalar& s) { return cv::Vec3d(s[0], s[1], s[2]); };
-	return {cv::Vec3d(0, 0, 0), v(o.white_bgr), v(o.black_bgr), v(o.green_bgr),
-			cv::Vec3d(kOccluderGrey, kOccluderGrey, kOccluderGrey)};
+	return {
+		cv::Vec3d(0, 0, 0), v(o.white_bgr), v(o.black_bgr), v(o.green_bgr),
+		cv::Vec3d(kOccluderGrey, kOccluderGrey, kOccluderGrey)};
 }
 
 /** Without lens distortion: exact area coverage of the projected nested
@@ -118,8 +129,10 @@ void drawLandmarkExact(
 	cv::Mat& img, const CameraModel& cam, const Rigid& cam_T_lm, const Face& face,
 	const RenderOptions& o)
 {
-	const auto project = [&](const Polygon3& p) {
-		return detail::projectPinhole(detail::clipNear(p, kNearM), cam.fx(), cam.fy(), cam.cx(), cam.cy());
+	const auto project = [&](const Polygon3& p)
+	{
+		return detail::projectPinhole(
+			detail::clipNear(p, kNearM), cam.fx(), cam.fy(), cam.cx(), cam.cy());
 	};
 	// Layers, each nested in the one before, except the occluder.
 	const Polygon2 sheet = project(faceSquare(cam_T_lm, face.sheet_half));
@@ -170,7 +183,7 @@ void drawLandmarkExact(
 			if (c0[x] == 0 && co[x] == 0) continue;
 			const cv::Vec3d bg(px[x][0], px[x][1], px[x][2]);
 			cv::Vec3d v = bg * (1 - c0[x]) + col[kWhite] * (c0[x] - c1[x]) +
-				col[kBlack] * (c1[x] - c2[x] + c3[x]) + col[kGreen] * (c2[x] - c3[x]);
+						  col[kBlack] * (c1[x] - c2[x] + c3[x]) + col[kGreen] * (c2[x] - c3[x]);
 			v = v * (1 - co[x]) + col[kOccluder] * co[x];
 			px[x] = cv::Vec3f(float(v[0]), float(v[1]), float(v[2]));
 		}
@@ -189,7 +202,7 @@ struct CornerGrid
 	std::vector<double> key;  //!< the camera it belongs to
 	int width = 0;
 	std::vector<Eigen::Vector2d> xn;
-	double max_r2 = 0;  //!< largest |xn|^2 over the image: the field of view
+	double max_r2 = 0;	//!< largest |xn|^2 over the image: the field of view
 };
 
 /** The corner grid of \a cam, computed once and cached for the last camera
@@ -197,7 +210,8 @@ struct CornerGrid
 std::shared_ptr<const CornerGrid> cornerGrid(const CameraModel& cam)
 {
 	const auto& p = cam.params();
-	std::vector<double> key{double(p.ncols), double(p.nrows), cam.fx(), cam.fy(), cam.cx(), cam.cy()};
+	std::vector<double> key{double(p.ncols), double(p.nrows), cam.fx(),
+							cam.fy(),		 cam.cx(),		  cam.cy()};
 	key.insert(key.end(), p.dist.begin(), p.dist.end());
 	static std::mutex mutex;
 	static std::shared_ptr<const CornerGrid> cached;
@@ -231,7 +245,8 @@ void drawLandmarkSampled(
 	const CornerGrid& grid = *corners;
 	std::vector<Eigen::Vector2d> outline;
 	bool leaves_view = false;
-	const auto addOutline = [&](const Polygon3& poly) {
+	const auto addOutline = [&](const Polygon3& poly)
+	{
 		const Polygon3 p = detail::clipNear(poly, kNearM);
 		for (size_t i = 0; i < p.size(); ++i)
 			for (int k = 0; k < 64; ++k)
@@ -272,7 +287,8 @@ void drawLandmarkSampled(
 			const Eigen::Vector2d& g10 = grid.xn[i00 + 1];
 			const Eigen::Vector2d& g01 = grid.xn[i00 + gw];
 			const Eigen::Vector2d& g11 = grid.xn[i00 + gw + 1];
-			const auto paintOf = [&](const Eigen::Vector2d& xn) {
+			const auto paintOf = [&](const Eigen::Vector2d& xn)
+			{
 				const Eigen::Vector3d q = Minv * Eigen::Vector3d(xn.x(), xn.y(), 1.0);
 				// q = (s, t, 1) / depth: behind the camera when q.z <= 0.
 				return q.z() > 0 ? face.paintAt(q.x() / q.z(), q.y() / q.z()) : kBackground;
@@ -331,7 +347,8 @@ LandmarkTruth truthOf(const MapLandmark& lm, const Scene& scene, Rigid* cam_T_lm
 		if (auto px = cam.project(p))
 		{
 			tr.corners_px[i] = *px;
-			tr.corners_ideal_px[i] = {cam.fx() * p.x() / p.z() + cam.cx(), cam.fy() * p.y() / p.z() + cam.cy()};
+			tr.corners_ideal_px[i] = {
+				cam.fx() * p.x() / p.z() + cam.cx(), cam.fy() * p.y() / p.z() + cam.cy()};
 		}
 		else
 		{
@@ -364,11 +381,13 @@ LandmarkTruth truthOf(const MapLandmark& lm, const Scene& scene, Rigid* cam_T_lm
 			const Eigen::Vector3d p = cam_T_lm * LandmarkGeometry::faceToLandmark(f.x(), f.y());
 			const auto px = cam.project(p);
 			inside = px && px->x() >= 0.5 && px->x() <= cam.width() - 1.5 && px->y() >= 0.5 &&
-				px->y() <= cam.height() - 1.5;
+					 px->y() <= cam.height() - 1.5;
 			// Beyond the field of view a lens polynomial can fold points
 			// back into the image: such a pixel does not undistort back.
 			if (inside && cam.hasDistortion())
-				inside = (cam.undistortToNormalized(*px) - Eigen::Vector2d(p.x() / p.z(), p.y() / p.z())).norm() < 1e-6;
+				inside =
+					(cam.undistortToNormalized(*px) - Eigen::Vector2d(p.x() / p.z(), p.y() / p.z()))
+						.norm() < 1e-6;
 		}
 	tr.fully_visible = inside;
 	tr.sighting = sightingTruth(tr.landmark_T_camera);
@@ -440,14 +459,15 @@ Render render(const Scene& scene, const RenderOptions& o, uint64_t seed)
 	const auto& lms = scene.map.landmarks;
 	std::vector<Rigid> cam_T_lm(lms.size());
 	out.truth.reserve(lms.size());
-	for (size_t i = 0; i < lms.size(); ++i) out.truth.push_back(truthOf(lms[i], scene, &cam_T_lm[i]));
+	for (size_t i = 0; i < lms.size(); ++i)
+		out.truth.push_back(truthOf(lms[i], scene, &cam_T_lm[i]));
 
 	// Far to near, so that nearer landmarks cover farther ones.
 	std::vector<size_t> order(lms.size());
 	std::iota(order.begin(), order.end(), size_t(0));
-	std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-		return cam_T_lm[a].t.norm() > cam_T_lm[b].t.norm();
-	});
+	std::stable_sort(
+		order.begin(), order.end(),
+		[&](size_t a, size_t b) { return cam_T_lm[a].t.norm() > cam_T_lm[b].t.norm(); });
 	cv::RNG occ_rng(detail::streamSeed(seed, 3));
 	std::shared_ptr<const CornerGrid> corners;
 	if (cam.hasDistortion()) corners = cornerGrid(cam);
@@ -470,7 +490,8 @@ Render render(const Scene& scene, const RenderOptions& o, uint64_t seed)
 	// quantisation), then the codec.
 	applyIllumination(img, o);
 	if (o.blur_sigma_px > 0)
-		cv::GaussianBlur(img, img, cv::Size(0, 0), o.blur_sigma_px, o.blur_sigma_px, cv::BORDER_REPLICATE);
+		cv::GaussianBlur(
+			img, img, cv::Size(0, 0), o.blur_sigma_px, o.blur_sigma_px, cv::BORDER_REPLICATE);
 	applyMotionBlur(img, o.motion_blur_px, o.motion_blur_angle_rad);
 	if (o.noise_sigma > 0)
 	{
@@ -479,7 +500,7 @@ Render render(const Scene& scene, const RenderOptions& o, uint64_t seed)
 		rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
 		img += noise;
 	}
-	img.convertTo(out.image, CV_8UC3);  // rounds and clamps to 0..255
+	img.convertTo(out.image, CV_8UC3);	// rounds and clamps to 0..255
 	if (o.jpeg_quality > 0)
 	{
 		std::vector<uchar> buf;
@@ -500,7 +521,7 @@ mrpt::poses::CPose3D levelCameraLookingAt(
 		distance_m * std::cos(view_angle_rad), distance_m * std::sin(view_angle_rad), height_m,
 		view_angle_rad + M_PI - bearing_rad, 0, 0);
 	return landmark.world_T_landmark() + lm_T_body +
-		mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+		   mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 }
 
 }  // namespace codemark::sim

@@ -20,13 +20,13 @@ namespace codemark::detect
 /** Wall-clock time of each stage for one image [microseconds]. */
 struct StageTimings
 {
-	double segmentation_us = 0;  //!< smoothing + colour mask
+	double segmentation_us = 0;	 //!< smoothing + colour mask
 	double components_us = 0;  //!< connected components, moments, ROIs
 	double edgels_us = 0;  //!< gradients, edgels, edgel domains (all ROIs)
-	double segments_us = 0;  //!< side selection (all ROIs)
+	double segments_us = 0;	 //!< side selection (all ROIs)
 	double quads_us = 0;  //!< linking into quadrangles (all ROIs)
-	double subpixel_us = 0;  //!< edge profiles, line fits, corners (all ROIs)
-	double code_us = 0;  //!< frame check and code reading (all ROIs)
+	double subpixel_us = 0;	 //!< edge profiles, line fits, corners (all ROIs)
+	double code_us = 0;	 //!< frame check and code reading (all ROIs)
 	double total_us = 0;  //!< the whole detect() call, debug images excluded
 };
 
@@ -42,10 +42,10 @@ struct DetectedLandmark
 /** Counts of candidates surviving each stage (for tuning and debugging). */
 struct StageCounts
 {
-	int components = 0;  //!< connected components of the mask
+	int components = 0;	 //!< connected components of the mask
 	int rois = 0;  //!< components that passed area and shape tests
-	int quads = 0;  //!< ROIs where four sides were linked
-	int fitted = 0;  //!< quadrangles with four good line fits
+	int quads = 0;	//!< ROIs where four sides were linked
+	int fitted = 0;	 //!< quadrangles with four good line fits
 	int decoded = 0;  //!< landmarks reported
 };
 

@@ -30,7 +30,7 @@ namespace codemark::filters
 enum class EkfMeasurement
 {
 	Landmark,  //!< L = [l2 phi1 phi2] with C_L ("ekf")
-	PoseFix  //!< the robot pose from one landmark with C_R propagated ("ekf-pose")
+	PoseFix	 //!< the robot pose from one landmark with C_R propagated ("ekf-pose")
 };
 
 /** Options of both EKF variants (ini section `[ekf]`). */
@@ -60,7 +60,7 @@ struct EkfOptions : public mrpt::config::CLoadableOptions
 	 * must be >= -tol * max(1, largest); smaller negative ones throw. Tiny
 	 * eigenvalues in between are raised to min_eigenvalue. */
 	double pd_tolerance = 1e-9;
-	double min_eigenvalue = 1e-12;  //!< floor of the covariance's eigenvalues [m^2 or rad^2]
+	double min_eigenvalue = 1e-12;	//!< floor of the covariance's eigenvalues [m^2 or rad^2]
 
 	/** Throws std::invalid_argument naming the bad key. */
 	void validate() const;

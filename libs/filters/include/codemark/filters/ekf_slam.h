@@ -53,7 +53,7 @@ enum class SlamInput
 	 * (so a rawlog annotated with both, twins of each other, is not fused
 	 * twice). */
 	Auto,
-	Coded,  //!< only CObservationCodedLandmarks
+	Coded,	//!< only CObservationCodedLandmarks
 	BearingRange,  //!< only CObservationBearingRange
 	Both  //!< everything (only for independent sensors)
 };
@@ -72,8 +72,8 @@ enum class SlamLandmarks
  * options, e.g. `method`, `enable_profiler`, in `[ekf_slam_kf]`). */
 struct EkfSlamOptions : public mrpt::config::CLoadableOptions
 {
-	SlamInput input = SlamInput::Auto;  //!< which observations to fuse
-	SlamLandmarks landmarks = SlamLandmarks::Auto;  //!< landmark state (ini: auto, full, point)
+	SlamInput input = SlamInput::Auto;	//!< which observations to fuse
+	SlamLandmarks landmarks = SlamLandmarks::Auto;	//!< landmark state (ini: auto, full, point)
 	/** Chi-square gate: a sighting of a mapped landmark is fused when its
 	 * squared Mahalanobis innovation distance is below
 	 * chi2inv(gate_probability, dof), dof = 3 for L, 2 for range-bearing.
@@ -93,7 +93,7 @@ struct EkfSlamOptions : public mrpt::config::CLoadableOptions
 	double point_yaw_sigma_deg = 180.0;
 	/** Added to the odometry's covariance per step: x, y [m^2], yaw [rad^2]. */
 	double extra_motion_var_xy_m2 = 0.0;
-	double extra_motion_var_yaw_rad2 = 0.0;  //!< see extra_motion_var_xy_m2
+	double extra_motion_var_yaw_rad2 = 0.0;	 //!< see extra_motion_var_xy_m2
 	/** A step without odometry keeps the robot still with this noise: x, y
 	 * sigma [m] and yaw sigma [deg] (0: no noise, as when it stands still). */
 	double std_no_odo_xy = 0.0;

@@ -51,7 +51,7 @@ class GroundTruth
 
    private:
 	Form form_ = Form::Timestamped;
-	std::vector<double> times_;  // Timestamped only, ascending
+	std::vector<double> times_;	 // Timestamped only, ascending
 	std::vector<mrpt::poses::CPose2D> poses_;
 };
 

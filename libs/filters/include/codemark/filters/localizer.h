@@ -24,8 +24,8 @@ namespace codemark::filters
 struct PoseEstimate
 {
 	bool initialized = false;  //!< false until a first fix (global initialisation)
-	mrpt::poses::CPose2D mean;  //!< x, y [m], yaw [rad]
-	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  //!< covariance of (x, y, yaw)
+	mrpt::poses::CPose2D mean;	//!< x, y [m], yaw [rad]
+	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();	//!< covariance of (x, y, yaw)
 };
 
 /** What one step did with the frame's sightings. */
@@ -33,15 +33,15 @@ struct StepStats
 {
 	int used = 0;  //!< sightings fused
 	int rejected = 0;  //!< sightings gated out (chi-square) or otherwise rejected
-	int unknown_id = 0;  //!< sightings of IDs not in the map (localization only)
-	bool reinitialized = false;  //!< the filter (re)initialised from landmarks in this step
+	int unknown_id = 0;	 //!< sightings of IDs not in the map (localization only)
+	bool reinitialized = false;	 //!< the filter (re)initialised from landmarks in this step
 };
 
 /** A landmark of a SLAM map with its covariance. */
 struct MappedLandmark
 {
 	MapLandmark landmark;  //!< id, x, y, z, yaw
-	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();  //!< covariance of (x, y, yaw) [m, rad]
+	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();	//!< covariance of (x, y, yaw) [m, rad]
 };
 
 /** One filter. */
@@ -76,7 +76,7 @@ class Localizer
  * itself from its first sightings (global initialisation). Throws
  * std::invalid_argument naming the method or key on bad configuration. */
 std::unique_ptr<Localizer> makeLocalizer(
-	const std::string& method, const mrpt::config::CConfigFileBase& cfg,
-	const LandmarkMap& map, const std::optional<PoseEstimate>& initial = std::nullopt);
+	const std::string& method, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
+	const std::optional<PoseEstimate>& initial = std::nullopt);
 
 }  // namespace codemark::filters

@@ -21,9 +21,11 @@ namespace codemark::filters
 struct LocalizeRequest
 {
 	std::string config_file;  //!< the method's ini (share/codemark/config/<method>.ini)
-	std::string rawlog;  //!< input rawlog (either format)
-	std::string map_file;  //!< landmark map (spec section 3) or MRPT landmark file; may be empty for SLAM
-	std::string method;  //!< ekf | ekf-pose | ekf-slam | pf; empty: the ini's [localize] method, else ekf
+	std::string rawlog;	 //!< input rawlog (either format)
+	std::string
+		map_file;  //!< landmark map (spec section 3) or MRPT landmark file; may be empty for SLAM
+	std::string
+		method;	 //!< ekf | ekf-pose | ekf-slam | pf; empty: the ini's [localize] method, else ekf
 	std::string gt_file;  //!< ground truth (either form of spec section 6); may be empty
 	/** SLAM: the true landmark map (spec section 3 or MRPT's landmark file)
 	 * for summary.json's landmark_rmse_m; may be empty. */
@@ -37,8 +39,8 @@ struct LocalizeSummary;
  * far (its rows up to this step; metrics not yet computed), the map in use
  * (empty for SLAM without a prior map) and the filter (e.g. its
  * landmarks()). */
-using StepObserver =
-	std::function<void(const LocalizeSummary& so_far, const LandmarkMap& map, const Localizer& filter)>;
+using StepObserver = std::function<void(
+	const LocalizeSummary& so_far, const LandmarkMap& map, const Localizer& filter)>;
 
 /** One processed camera frame. */
 struct PathRow
@@ -47,15 +49,15 @@ struct PathRow
 	double timestamp = 0;  //!< UNIX s, or the step index
 	PoseEstimate estimate;
 	StepStats stats;
-	std::optional<mrpt::poses::CPose2D> truth;  //!< matched ground truth
+	std::optional<mrpt::poses::CPose2D> truth;	//!< matched ground truth
 };
 
 /** Accuracy against ground truth over the initialised steps with a match. */
 struct PathMetrics
 {
 	int matched = 0;  //!< steps compared
-	double ate_rmse_m = 0;  //!< RMS of the position error [m]
-	double max_error_m = 0;  //!< largest position error [m]
+	double ate_rmse_m = 0;	//!< RMS of the position error [m]
+	double max_error_m = 0;	 //!< largest position error [m]
 	double yaw_rmse_deg = 0;  //!< RMS of the wrapped yaw error [deg]
 	double nees_mean = 0;  //!< mean of e^T P^-1 e (3 DoF: x, y, yaw)
 	/** Two-sided 95% band of the mean NEES of a consistent filter:
@@ -89,17 +91,17 @@ struct PathMetrics
 struct LocalizeSummary
 {
 	std::string method;
-	long steps = 0;  //!< processed camera frames
+	long steps = 0;	 //!< processed camera frames
 	long sightings_used = 0, sightings_rejected = 0, sightings_unknown_id = 0;
 	/** Coded sightings dropped before the filter as seen beyond
 	 * [stepper] max_view_angle_deg (not in sightings_rejected). */
 	long sightings_too_oblique = 0;
-	long reinitializations = 0;  //!< global initialisation and kidnap recoveries
+	long reinitializations = 0;	 //!< global initialisation and kidnap recoveries
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
 	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]
-	double detect_ms_per_image = 0;  //!< mean on-the-fly detection time [ms] (0: none)
-	std::optional<PathMetrics> metrics;  //!< with ground truth
+	double detect_ms_per_image = 0;	 //!< mean on-the-fly detection time [ms] (0: none)
+	std::optional<PathMetrics> metrics;	 //!< with ground truth
 	std::vector<PathRow> rows;
 	std::vector<MappedLandmark> slam_map;  //!< SLAM only
 };
@@ -119,8 +121,9 @@ mrpt::poses::CPose2D alignSE2(
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
  * with one line naming the file, line or entry on bad input. */
-LocalizeSummary runLocalization(const LocalizeRequest& request,
-	const std::function<void(double)>& progress = {}, const StepObserver& on_step = {});
+LocalizeSummary runLocalization(
+	const LocalizeRequest& request, const std::function<void(double)>& progress = {},
+	const StepObserver& on_step = {});
 
 /** Writes the output files of \a s into \a out_dir (created). \a map: the
  * map used (drawn in the plot and the 3D scene). */

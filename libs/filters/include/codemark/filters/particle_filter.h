@@ -24,12 +24,12 @@ namespace codemark::filters
 /** [ParticleFilter]: what MRPT's own option blocks do not cover. */
 struct ParticleFilterOptions : public mrpt::config::CLoadableOptions
 {
-	int particles_count = 2000;  //!< initial number of particles (KLD may change it)
+	int particles_count = 2000;	 //!< initial number of particles (KLD may change it)
 	/** Uniform initialisation: the landmarks' bounding box grown by this
 	 * margin on each side [m]. */
 	double init_margin_m = 0.5;
-	double initial_std_xy_m = 0.2;  //!< spread around a given initial pose [m]
-	double initial_std_yaw_deg = 10.0;  //!< spread around a given initial pose [deg]
+	double initial_std_xy_m = 0.2;	//!< spread around a given initial pose [m]
+	double initial_std_yaw_deg = 10.0;	//!< spread around a given initial pose [deg]
 
 	/** Injection: fraction of the particles replaced by samples around the
 	 * frame's single-landmark fixes, in (0, 1]. */
@@ -44,7 +44,7 @@ struct ParticleFilterOptions : public mrpt::config::CLoadableOptions
 	/** Inject after this many consecutive unexplained frames once converged
 	 * (kidnapping); before the first convergence after one (0 disables). */
 	int inject_after_unexplained = 2;
-	double inject_min_std_xy_m = 0.02;  //!< floor of the injected spread (added to the fix's C) [m]
+	double inject_min_std_xy_m = 0.02;	//!< floor of the injected spread (added to the fix's C) [m]
 	double inject_min_std_yaw_deg = 1.0;  //!< floor of the injected spread [deg]
 
 	/** estimate().initialized becomes true (and stays) once the particle

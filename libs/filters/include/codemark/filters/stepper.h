@@ -59,11 +59,11 @@ struct StepperOptions : public mrpt::config::CLoadableOptions
 /** One processed camera frame. */
 struct RawlogStep
 {
-	long index = 0;  //!< 0, 1, 2, ... in rawlog order
-	long entry = 0;  //!< index of the rawlog entry that completed the frame
+	long index = 0;	 //!< 0, 1, 2, ... in rawlog order
+	long entry = 0;	 //!< index of the rawlog entry that completed the frame
 	/** UNIX time [s] of the frame; the step index when the rawlog has none. */
 	double timestamp = 0;
-	bool has_timestamp = false;  //!< false: timestamp is the step index
+	bool has_timestamp = false;	 //!< false: timestamp is the step index
 	/** Actions-observations format: the number of CActionCollection entries
 	 * read before this frame (0 for a sensory frame ahead of the first
 	 * action, i.e. taken at the start pose). It indexes an MRPT robot-path

@@ -18,7 +18,7 @@ struct LandmarkGeometry : public mrpt::config::CLoadableOptions
 {
 	double outer_size_m = 0.200;  //!< outer edge of the black frame [m]
 	double inner_size_m = 0.160;  //!< inner edge of the frame: the reference square [m]
-	double cell_size_m = 0.030;  //!< one code-board cell (3x3 board, centred) [m]
+	double cell_size_m = 0.030;	 //!< one code-board cell (3x3 board, centred) [m]
 	double margin_m = 0.005;  //!< minimum white quiet margin around the frame [m]
 
 	/** The A4 landmark with every size multiplied by \a scale (> 0). */
@@ -51,11 +51,9 @@ struct LandmarkGeometry : public mrpt::config::CLoadableOptions
 	void validate() const;
 
 	void loadFromConfigFile(
-		const mrpt::config::CConfigFileBase& source,
-		const std::string& section) override;
+		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 	void saveToConfigFile(
-		mrpt::config::CConfigFileBase& target,
-		const std::string& section) const override;
+		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };
 
 }  // namespace codemark

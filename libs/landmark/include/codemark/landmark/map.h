@@ -17,10 +17,10 @@ namespace codemark
 /** One landmark of a map. */
 struct MapLandmark
 {
-	int id = 0;  //!< 0..255
+	int id = 0;	 //!< 0..255
 	double x_m = 0, y_m = 0, z_m = 0;  //!< centre of the green square, world frame [m]
-	double yaw_rad = 0;  //!< direction of the outward normal X_L in the world [rad]
-	double scale = 1.0;  //!< multiplies every size of the A4 landmark
+	double yaw_rad = 0;	 //!< direction of the outward normal X_L in the world [rad]
+	double scale = 1.0;	 //!< multiplies every size of the A4 landmark
 
 	/** Pose of frame L in the world: CPose3D(x, y, z, yaw, 0, 0). */
 	mrpt::poses::CPose3D world_T_landmark() const;

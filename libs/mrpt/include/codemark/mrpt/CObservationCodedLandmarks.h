@@ -34,16 +34,16 @@ class CObservationCodedLandmarks : public mrpt::obs::CObservation
 		/** Reference points in raw image pixels, TL, TR, BR, BL. */
 		std::array<Eigen::Vector2d, 4> corners{};
 		Eigen::Vector4d P = Eigen::Vector4d::Zero();  //!< [x1 y1 x2 y2] [px]
-		Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();  //!< covariance of P [px^2]
+		Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();	//!< covariance of P [px^2]
 		/** [l2 phi1 phi2]: horizontal range [m], bearing [rad], relative
 		 * orientation [rad] (landmark-spec.md section 4). */
 		Eigen::Vector3d L = Eigen::Vector3d::Zero();
-		Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();  //!< covariance of L
+		Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< covariance of L
 		/** Camera's planar pose in the landmark frame: x, y [m], theta [rad]. */
 		Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();
-		Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();  //!< covariance of that pose
+		Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();	//!< covariance of that pose
 		DetectionQuality quality;
-		pose::PoseMethod method = pose::PoseMethod::ClosedForm;  //!< which path produced L
+		pose::PoseMethod method = pose::PoseMethod::ClosedForm;	 //!< which path produced L
 
 		/** A sighting from a detection and its measurement. */
 		static TSighting From(const Detection& d, const pose::Measurement& m);
@@ -54,7 +54,7 @@ class CObservationCodedLandmarks : public mrpt::obs::CObservation
 	/** The camera's optical frame on the robot (MRPT camera convention: z
 	 * along the optical axis, x right, y down), as CObservationImage's. */
 	mrpt::poses::CPose3D cameraPose;
-	mrpt::img::TCamera camera;  //!< intrinsics of the image's camera
+	mrpt::img::TCamera camera;	//!< intrinsics of the image's camera
 	std::vector<TSighting> sightings;  //!< one per landmark detected
 
 	void getSensorPose(mrpt::poses::CPose3D& out) const override { out = cameraPose; }

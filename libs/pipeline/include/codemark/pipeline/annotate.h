@@ -15,7 +15,7 @@ namespace codemark::pipeline
 struct AnnotateOptions
 {
 	PipelineOptions pipeline;
-	bool bearing_range = false;  //!< also insert the CObservationBearingRange twin (`<CAM>_BR`)
+	bool bearing_range = false;	 //!< also insert the CObservationBearingRange twin (`<CAM>_BR`)
 	bool drop_images = false;  //!< leave the image observations out of the output
 	int threads = 0;  //!< worker threads; 0: the number of cores
 };
@@ -25,10 +25,10 @@ struct AnnotateSummary
 	long entries = 0;  //!< objects read from the input
 	long images = 0;  //!< image observations processed
 	long detections = 0;  //!< landmark sightings written
-	std::map<int, long> per_id;  //!< sightings per landmark ID
-	double detect_ms_per_image = 0;  //!< mean detector time per image
-	double wall_s = 0;  //!< total wall time
-	bool actions_observations = false;  //!< the input's format
+	std::map<int, long> per_id;	 //!< sightings per landmark ID
+	double detect_ms_per_image = 0;	 //!< mean detector time per image
+	double wall_s = 0;	//!< total wall time
+	bool actions_observations = false;	//!< the input's format
 };
 
 /** Annotates \a in_path into \a out_path. Calls \a progress(bytes read,

@@ -54,15 +54,16 @@ namespace codemark::pipeline
  * and 0.0125 px): these values are conservative there. Re-run the
  * calibration (scripts/bench-accuracy.sh) when the detector changes. */
 constexpr double kDetectorSigmaXPx = 0.0375;  //!< constant part of sigma(x1), sigma(x2) [px]
-constexpr double kDetectorSigmaYPx = 0.040;  //!< constant part of sigma(y1), sigma(y2) [px]
+constexpr double kDetectorSigmaYPx = 0.040;	 //!< constant part of sigma(y1), sigma(y2) [px]
 constexpr double kDetectorGrowthXPx = 0.040;  //!< sigma(x) growth term at 30 px apparent width [px]
-constexpr double kDetectorGrowthYPx = 0.055;  //!< sigma(y) growth term at 30 px apparent height [px]
-constexpr double kDetectorSizeExponentX = 1.25;  //!< exponent of the x growth
-constexpr double kDetectorSizeExponentY = 1.25;  //!< exponent of the y growth
-constexpr double kDetectorCorrX12 = -0.80;  //!< corr(x1, x2), constant part
+constexpr double kDetectorGrowthYPx =
+	0.055;	//!< sigma(y) growth term at 30 px apparent height [px]
+constexpr double kDetectorSizeExponentX = 1.25;	 //!< exponent of the x growth
+constexpr double kDetectorSizeExponentY = 1.25;	 //!< exponent of the y growth
+constexpr double kDetectorCorrX12 = -0.80;	//!< corr(x1, x2), constant part
 constexpr double kDetectorCorrGrowthX12 = -0.50;  //!< corr(x1, x2), growing part
 constexpr double kDetectorCorrY12 = 0.85;  //!< corr(y1, y2), constant part
-constexpr double kDetectorCorrGrowthY12 = 0.55;  //!< corr(y1, y2), growing part
+constexpr double kDetectorCorrGrowthY12 = 0.55;	 //!< corr(y1, y2), growing part
 
 /** The pose options codemark's detector is calibrated for (see above). */
 inline pose::PoseOptions detectorCalibratedPoseOptions()
@@ -109,7 +110,7 @@ struct ImageResult
 {
 	std::vector<MeasuredLandmark> landmarks;
 	detect::StageTimings timings;  //!< the detector's own time
-	double pose_us = 0;  //!< time spent in the pose library [us]
+	double pose_us = 0;	 //!< time spent in the pose library [us]
 };
 
 /** The geometry of landmark \a id under \a o (its map scale, else the default). */

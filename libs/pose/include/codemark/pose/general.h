@@ -27,12 +27,12 @@ namespace codemark::pose
 /** One refined PnP solution. */
 struct PnPSolution
 {
-	mrpt::poses::CPose3D landmark_T_camera;  //!< optical frame in frame L
+	mrpt::poses::CPose3D landmark_T_camera;	 //!< optical frame in frame L
 	/** OpenCV's parameters of the landmark model in the camera frame: rvec
 	 * (Rodrigues, rad) and tvec [m], model frame M = (Y_L, -Z_L, -X_L)
 	 * (identity rotation for a level camera squarely facing the landmark). */
 	Eigen::Matrix<double, 6, 1> rvec_tvec = Eigen::Matrix<double, 6, 1>::Zero();
-	double rms_px = 0;  //!< RMS reprojection error over the 8 corner coordinates [px]
+	double rms_px = 0;	//!< RMS reprojection error over the 8 corner coordinates [px]
 	/** Covariance of rvec_tvec from the corner noise: sigma^2 (J^T J)^-1, J the
 	 * 8x6 Jacobian of the raw-pixel projections (cv::projectPoints). */
 	Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
@@ -48,7 +48,7 @@ struct GeneralPose
 	double ambiguity_ratio = 0;
 	Eigen::Vector3d L = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] of the best solution
 	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();
-	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();  //!< (x, y, theta) in L
+	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();	 //!< (x, y, theta) in L
 	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();
 };
 

@@ -65,7 +65,7 @@ constexpr double kDefaultSigmaPx = 0.05;
 /** Options of measure(). Loadable from an ini section. */
 struct PoseOptions : public mrpt::config::CLoadableOptions
 {
-	PoseMethod method = PoseMethod::ClosedForm;  //!< ini key `method` = ClosedForm | General6Dof
+	PoseMethod method = PoseMethod::ClosedForm;	 //!< ini key `method` = ClosedForm | General6Dof
 	/** Standard deviation of each component of P = [x1 y1 x2 y2] [px]
 	 * (C_P = diag(s^2, s^2, s^2, s^2)). Each corner coordinate then has
 	 * sqrt(2) * sigma_px, which the general path uses. */
@@ -89,9 +89,10 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double growth_x_px = 0;
 	/** The same for y1, y2 with h = y1 + y2 the apparent height [px]. */
 	double growth_y_px = 0;
-	double size_exponent_x = 2;  //!< exponent of the growth of x1, x2 (see growth_x_px)
-	double size_exponent_y = 2;  //!< exponent of the growth of y1, y2 (see growth_x_px)
-	double size_reference_px = 30;  //!< apparent size at which the growth term equals growth_*_px [px]
+	double size_exponent_x = 2;	 //!< exponent of the growth of x1, x2 (see growth_x_px)
+	double size_exponent_y = 2;	 //!< exponent of the growth of y1, y2 (see growth_x_px)
+	double size_reference_px =
+		30;	 //!< apparent size at which the growth term equals growth_*_px [px]
 	/** Correlation coefficient (-1..1) of the errors of x1 and x2 in the
 	 * constant (sigma_px) part of their noise. Negative: the two inner
 	 * vertical edges move apart or together (the square's apparent width,
@@ -110,12 +111,12 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** C_P of a measured or predicted P under these options (without the
 	 * detector's own sigma), the sum of a constant and a size-dependent part,
 	 * each with its correlation of the two edges:
-	 *   var(x1) = var(x2) = sigma_px^2 + gx^2,  cov(x1, x2) = corr_x12 sigma_px^2 + corr_growth_x12 gx^2,
-	 *   var(y1) = var(y2) = sigma_y^2 + gy^2,   cov(y1, y2) = corr_y12 sigma_y^2 + corr_growth_y12 gy^2,
-	 * gx = growth_x_px (size_reference_px / (x2 - x1))^size_exponent_x,
-	 * gy = growth_y_px (size_reference_px / (y1 + y2))^size_exponent_y, no x-y
-	 * terms. With the growth terms and correlations at 0 this is the spec's
-	 * C_P = diag(sigma_px^2, sigma_y^2, sigma_px^2, sigma_y^2). */
+	 *   var(x1) = var(x2) = sigma_px^2 + gx^2,  cov(x1, x2) = corr_x12 sigma_px^2 + corr_growth_x12
+	 * gx^2, var(y1) = var(y2) = sigma_y^2 + gy^2,   cov(y1, y2) = corr_y12 sigma_y^2 +
+	 * corr_growth_y12 gy^2, gx = growth_x_px (size_reference_px / (x2 - x1))^size_exponent_x, gy =
+	 * growth_y_px (size_reference_px / (y1 + y2))^size_exponent_y, no x-y terms. With the growth
+	 * terms and correlations at 0 this is the spec's C_P = diag(sigma_px^2, sigma_y^2, sigma_px^2,
+	 * sigma_y^2). */
 	Eigen::Matrix4d primaryCovariance(const Eigen::Vector4d& P) const;
 	/** ini key `sigma_source` = Fixed | Detector (the latter only through
 	 * measure(const Detection&, ...)). */
@@ -145,15 +146,15 @@ struct Measurement
 	 * vertical inner edges, from the undistorted corners, in px of focal
 	 * length lambda = fx relative to the principal point. */
 	Eigen::Vector4d P = Eigen::Vector4d::Zero();
-	Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();  //!< covariance of P [px^2]
+	Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();	//!< covariance of P [px^2]
 	/** L = [l2 [m], phi1 [rad], phi2 [rad]] (spec section 4). */
 	Eigen::Vector3d L = Eigen::Vector3d::Zero();
-	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();  //!< covariance of L
+	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< covariance of L
 	/** The camera's planar pose in frame L: x, y [m] of the optical centre,
 	 * theta [rad] heading of the optical axis, wrapped to (-pi, pi]. */
 	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();
-	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();  //!< covariance of pose_in_landmark
-	PoseMethod method = PoseMethod::ClosedForm;  //!< the path that produced it
+	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();	//!< covariance of pose_in_landmark
+	PoseMethod method = PoseMethod::ClosedForm;	 //!< the path that produced it
 
 	/** General path only: the camera's optical frame in frame L (6-DoF). */
 	mrpt::poses::CPose3D landmark_T_camera;

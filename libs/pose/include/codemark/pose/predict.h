@@ -43,11 +43,11 @@ struct Prediction
 	int id = -1;
 	/** Projected reference points, raw pixels, TL TR BR BL (valid when in_front). */
 	std::array<Eigen::Vector2d, 4> corners_px;
-	bool in_front = false;  //!< every outer frame corner in front of the camera
+	bool in_front = false;	//!< every outer frame corner in front of the camera
 	bool in_fov = false;  //!< every outer frame corner inside the image (with the margin)
 	bool facing = false;  //!< the camera is on the printed side (X_L > 0)
-	bool in_range = false;  //!< l2 <= max_range_m
-	bool angle_ok = false;  //!< view angle <= max_view_angle_deg
+	bool in_range = false;	//!< l2 <= max_range_m
+	bool angle_ok = false;	//!< view angle <= max_view_angle_deg
 	bool big_enough = false;  //!< min(2 y1, 2 y2) >= min_size_px
 	/** All of the above. */
 	bool visible() const
@@ -55,8 +55,8 @@ struct Prediction
 		return in_front && in_fov && facing && in_range && angle_ok && big_enough;
 	}
 
-	double view_angle_rad = 0;  //!< line of sight vs outward normal, CCW positive
-	double size_px = 0;  //!< min(2 y1, 2 y2) [px]
+	double view_angle_rad = 0;	//!< line of sight vs outward normal, CCW positive
+	double size_px = 0;	 //!< min(2 y1, 2 y2) [px]
 	/** The predicted measurement (closed form at the predicted P; valid when
 	 * in_front and facing). */
 	Measurement measurement;
@@ -93,8 +93,8 @@ Prediction predictSighting(
 /** The visible landmarks of \a map, best (lowest score) first. */
 std::vector<Prediction> rankLandmarks(
 	const mrpt::poses::CPose2D& world_T_robot, const Eigen::Matrix3d& robot_cov,
-	const mrpt::poses::CPose3D& robot_T_camera, const CameraModel& camera,
-	const LandmarkMap& map, const PoseOptions& options = PoseOptions(),
+	const mrpt::poses::CPose3D& robot_T_camera, const CameraModel& camera, const LandmarkMap& map,
+	const PoseOptions& options = PoseOptions(),
 	const VisibilityOptions& visibility = VisibilityOptions());
 
 }  // namespace codemark::pose

@@ -22,11 +22,11 @@ struct SightingUncertainty
 	/** The landmark's outer frame is in front of the camera and inside the
 	 * image; the other fields are meaningful only then. */
 	bool in_image = false;
-	double size_px = 0;  //!< vertical size of the reference square, min(2 y1, 2 y2) [px]
+	double size_px = 0;	 //!< vertical size of the reference square, min(2 y1, 2 y2) [px]
 	Measurement measurement;  //!< predicted P, L, C_L, pose_in_landmark, C_R
-	double sigma_l2_m = 0;  //!< standard deviation of the range l2 [m]
-	double sigma_phi1_rad = 0;  //!< of the bearing phi1 [rad]
-	double sigma_phi2_rad = 0;  //!< of phi2 [rad]
+	double sigma_l2_m = 0;	//!< standard deviation of the range l2 [m]
+	double sigma_phi1_rad = 0;	//!< of the bearing phi1 [rad]
+	double sigma_phi2_rad = 0;	//!< of phi2 [rad]
 	/** Position standard deviation along its worst direction: sqrt of the
 	 * largest eigenvalue of C_R's position block [m]. */
 	double sigma_position_m = 0;
@@ -40,16 +40,16 @@ struct SightingUncertainty
  * centre \a height_m above the landmark centre; \a sigma_px the noise of each
  * component of P. */
 SightingUncertainty predictUncertainty(
-	const CameraModel& camera, const LandmarkGeometry& geometry, double sigma_px,
-	double distance_m, double view_angle_rad, double bearing_rad = 0, double height_m = 0);
+	const CameraModel& camera, const LandmarkGeometry& geometry, double sigma_px, double distance_m,
+	double view_angle_rad, double bearing_rad = 0, double height_m = 0);
 
 /** The answer of sizeFor(). */
 struct SizeAdvice
 {
-	bool found = false;  //!< false: no printable scale meets the request in this image
+	bool found = false;	 //!< false: no printable scale meets the request in this image
 	double scale = 0;  //!< multiply the A4 landmark by this (outer frame 0.2 m * scale)
-	SightingUncertainty at;  //!< the prediction at that scale
-	std::string reason;  //!< why not found, or which requirement set the scale
+	SightingUncertainty at;	 //!< the prediction at that scale
+	std::string reason;	 //!< why not found, or which requirement set the scale
 };
 
 /** The smallest landmark scale (relative to the A4 landmark) that gives
@@ -78,19 +78,19 @@ std::string accuracyTable(
 /** Magnifications used by drawUncertaintyFigure(). */
 struct FigureScales
 {
-	double ellipse = 1;  //!< position ellipses
-	double heading = 1;  //!< heading wedges
+	double ellipse = 1;	 //!< position ellipses
+	double heading = 1;	 //!< heading wedges
 };
 
 /** Options of the paper's Fig. 3. */
 struct FigureOptions
 {
-	double sigma_px = kDefaultSigmaPx;  //!< noise of each component of P [px]
-	double scale = 1.0;  //!< landmark scale (1 = A4)
+	double sigma_px = kDefaultSigmaPx;	//!< noise of each component of P [px]
+	double scale = 1.0;	 //!< landmark scale (1 = A4)
 	double x_min_m = 0.5, x_max_m = 3.0;  //!< robot distances along the normal X_L [m]
 	double y_max_m = 2.0;  //!< robots at |Y_L| <= y_max_m [m]
 	double step_m = 0.5;  //!< grid step [m]
-	double max_view_angle_deg = 70;  //!< positions beyond this angle are skipped
+	double max_view_angle_deg = 70;	 //!< positions beyond this angle are skipped
 	double min_size_px = 30;  //!< positions where the square is smaller are marked "not detectable"
 	/** Magnification of the ellipses and heading wedges; 0 = automatic (the
 	 * largest ellipse's semi-major axis is about 0.45 of a grid step,
@@ -99,7 +99,7 @@ struct FigureOptions
 	/** Magnification of the heading wedges; 0 = automatic (the widest
 	 * wedge's half-angle about 20 deg, rounded down to 1-2-5, at least 1). */
 	double heading_magnification = 0;
-	double pixels_per_m = 160;  //!< drawing scale
+	double pixels_per_m = 160;	//!< drawing scale
 };
 
 /** Draws Fig. 3: the landmark seen from above, a robot (a level camera

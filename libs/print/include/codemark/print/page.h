@@ -22,8 +22,8 @@ struct Colour
 };
 
 constexpr Colour kBlack{0, 0, 0};  //!< frame and black code cells
-constexpr Colour kGreen{0, 255, 0};  //!< the fill, sRGB #00FF00 (spec section 1)
-constexpr Colour kWhite{255, 255, 255};  //!< the sheet and the quiet margin
+constexpr Colour kGreen{0, 255, 0};	 //!< the fill, sRGB #00FF00 (spec section 1)
+constexpr Colour kWhite{255, 255, 255};	 //!< the sheet and the quiet margin
 
 /** One axis-aligned filled rectangle on the page [mm]. Later rectangles are
  * painted over earlier ones. */
@@ -41,9 +41,9 @@ struct FilledRect
 struct TextLine
 {
 	std::string text;  //!< UTF-8 (ASCII in practice)
-	double centre_x_mm = 0;  //!< horizontal centre of the line [mm]
+	double centre_x_mm = 0;	 //!< horizontal centre of the line [mm]
 	double baseline_y_mm = 0;  //!< baseline, from the page's top edge [mm]
-	double size_mm = 0;  //!< font size (em height) [mm]
+	double size_mm = 0;	 //!< font size (em height) [mm]
 };
 
 /** One physical page [mm]: white background, then rects, then texts. */
@@ -51,16 +51,16 @@ struct Page
 {
 	double width_mm = 0;  //!< page width [mm]
 	double height_mm = 0;  //!< page height [mm]
-	std::vector<FilledRect> rects;  //!< in painting order
+	std::vector<FilledRect> rects;	//!< in painting order
 	std::vector<TextLine> texts;
 };
 
 /** Where one landmark sits on a page [mm]. */
 struct Placement
 {
-	int id = 0;  //!< landmark ID 0..255
-	double frame_x_mm = 0;  //!< outer frame's left edge [mm]
-	double frame_y_mm = 0;  //!< outer frame's top edge [mm]
+	int id = 0;	 //!< landmark ID 0..255
+	double frame_x_mm = 0;	//!< outer frame's left edge [mm]
+	double frame_y_mm = 0;	//!< outer frame's top edge [mm]
 	double ink_x_mm = 0;  //!< left edge of everything printed for it (frame, label) [mm]
 	double ink_y_mm = 0;  //!< top edge of the ink (the frame's top) [mm]
 	double ink_w_mm = 0;  //!< width of the ink (frame or estimated label width) [mm]
@@ -102,8 +102,7 @@ LandmarkExtent landmarkExtent(const LandmarkGeometry& geometry);
  * The caller keeps the quiet margin free. Throws std::out_of_range for an ID
  * outside 0..255. Returns where it went. */
 Placement appendLandmark(
-	Page& page, const LandmarkGeometry& geometry, int id, double frame_x_mm,
-	double frame_y_mm);
+	Page& page, const LandmarkGeometry& geometry, int id, double frame_x_mm, double frame_y_mm);
 
 /** A page holding landmark \a id alone: the ink with the quiet margin on
  * all sides (the landmark's exact size plus margin and label). */

@@ -17,7 +17,7 @@ enum class Format
 {
 	Svg,  //!< SVG, width/height in mm
 	Png,  //!< PNG at PrintOptions::dpi, dpi recorded in pHYs
-	Pdf  //!< PDF at exact size
+	Pdf	 //!< PDF at exact size
 };
 
 /** "svg", "png" or "pdf". */
@@ -43,19 +43,22 @@ struct PrintOptions
 {
 	std::vector<int> ids;  //!< landmark IDs, each 0..255, no repeats, at least one
 	std::string out_dir;  //!< output folder; created when missing
-	std::vector<Format> formats = {Format::Svg, Format::Png, Format::Pdf};  //!< files per landmark (or per sheet page)
-	double scale = 1.0;  //!< multiplies every size of the landmark (> 0) [-]
-	bool sheet = false;  //!< lay the landmarks on A4 pages instead of one file each
-	double paper_border_mm = kDefaultPaperBorder_mm;  //!< with sheet: blank border the printer leaves [mm], 0..50
+	std::vector<Format> formats = {
+		Format::Svg, Format::Png, Format::Pdf};	 //!< files per landmark (or per sheet page)
+	double scale = 1.0;	 //!< multiplies every size of the landmark (> 0) [-]
+	bool sheet = false;	 //!< lay the landmarks on A4 pages instead of one file each
+	double paper_border_mm =
+		kDefaultPaperBorder_mm;	 //!< with sheet: blank border the printer leaves [mm], 0..50
 	double dpi = 600;  //!< PNG resolution [dots per inch], 10..1200
-	std::string landmark_ini;  //!< optional ini whose [LANDMARK] section gives the sizes (then multiplied by scale); empty: the spec's A4 landmark
+	std::string landmark_ini;  //!< optional ini whose [LANDMARK] section gives the sizes (then
+							   //!< multiplied by scale); empty: the spec's A4 landmark
 };
 
 /** What run() did. */
 struct PrintReport
 {
-	std::vector<std::string> files;  //!< every file written, in order
-	int pages = 0;  //!< pages (one per landmark, or A4 sheets with --sheet)
+	std::vector<std::string> files;	 //!< every file written, in order
+	int pages = 0;	//!< pages (one per landmark, or A4 sheets with --sheet)
 };
 
 /** The landmark geometry of \a options: the ini's [LANDMARK] section (or the

@@ -23,7 +23,7 @@ namespace codemark::sim
 struct TimedPose2D
 {
 	double t = 0;  //!< UNIX time [s]
-	mrpt::poses::CPose2D pose;  //!< world frame: x, y [m], yaw [rad]
+	mrpt::poses::CPose2D pose;	//!< world frame: x, y [m], yaw [rad]
 };
 
 /** Everything that defines a simulated dataset; loadable from an ini file
@@ -33,24 +33,26 @@ struct DatasetOptions : public mrpt::config::CLoadableOptions
 {
 	// [map]
 	std::string map_file;  //!< landmark map (spec section 3); empty: a generated room
-	double room_width_m = 6.0;  //!< generated room: extent along world x [m], walls at x = 0 and x = width
-	double room_depth_m = 4.0;  //!< generated room: extent along world y [m]
+	double room_width_m =
+		6.0;  //!< generated room: extent along world x [m], walls at x = 0 and x = width
+	double room_depth_m = 4.0;	//!< generated room: extent along world y [m]
 	int room_landmarks = 12;  //!< generated room: landmarks spread evenly over the walls
-	double landmark_height_m = 0.6;  //!< generated room: height of the landmark centres [m]
+	double landmark_height_m = 0.6;	 //!< generated room: height of the landmark centres [m]
 	int first_id = 1;  //!< generated room: IDs first_id, first_id + 1, ...
 
 	// [trajectory]
-	std::string trajectory_file;  //!< `t x y yaw_rad` per line (t in s from the start); empty: a loop
-	double loop_margin_m = 1.2;  //!< generated loop: distance from the walls [m]
+	std::string
+		trajectory_file;  //!< `t x y yaw_rad` per line (t in s from the start); empty: a loop
+	double loop_margin_m = 1.2;	 //!< generated loop: distance from the walls [m]
 	double corner_radius_m = 0.6;  //!< generated loop: radius of its rounded corners [m]
-	double speed_mps = 0.4;  //!< generated loop: forward speed [m/s]
-	int loops = 1;  //!< generated loop: number of laps
+	double speed_mps = 0.4;	 //!< generated loop: forward speed [m/s]
+	int loops = 1;	//!< generated loop: number of laps
 
 	// [dataset]
-	double frame_rate_hz = 5.0;  //!< camera frames per second
-	double odometry_rate_hz = 20.0;  //!< odometry readings per second (observations-only format)
+	double frame_rate_hz = 5.0;	 //!< camera frames per second
+	double odometry_rate_hz = 20.0;	 //!< odometry readings per second (observations-only format)
 	double start_time = 1700000000.0;  //!< UNIX time of the first frame [s]
-	unsigned int seed = 1;  //!< seeds odometry noise and rendering: the dataset is a function of it
+	unsigned int seed = 1;	//!< seeds odometry noise and rendering: the dataset is a function of it
 
 	// [odometry]
 	/** MRPT's motion model (Gaussian or Thrun) used both to draw the odometry
@@ -63,7 +65,8 @@ struct DatasetOptions : public mrpt::config::CLoadableOptions
 	// [camera]
 	std::string camera_file;  //!< camera intrinsics (MRPT ini or YAML); empty: the paper's camera
 	std::string sensor_label = "CAM";  //!< label of the image observations
-	double camera_x_m = 0.1, camera_y_m = 0.0, camera_z_m = 0.6;  //!< camera centre on the robot [m]
+	double camera_x_m = 0.1, camera_y_m = 0.0,
+		   camera_z_m = 0.6;  //!< camera centre on the robot [m]
 	double camera_yaw_deg = 0.0;  //!< heading of the optical axis on the robot (level camera) [deg]
 
 	// [render]
@@ -97,11 +100,11 @@ std::vector<TimedPose2D> sampleTrajectory(const DatasetOptions& o, double rate_h
 /** What writeDataset() produced. */
 struct DatasetSummary
 {
-	int frames = 0;  //!< camera images written
-	int odometry_readings = 0;  //!< odometry entries (actions or observations)
-	int sightings = 0;  //!< fully visible landmarks over all frames
+	int frames = 0;	 //!< camera images written
+	int odometry_readings = 0;	//!< odometry entries (actions or observations)
+	int sightings = 0;	//!< fully visible landmarks over all frames
 	LandmarkMap map;
-	std::vector<TimedPose2D> ground_truth;  //!< robot pose at each image
+	std::vector<TimedPose2D> ground_truth;	//!< robot pose at each image
 };
 
 /** Writes into \a out_dir: `dataset.rawlog` (actions-observations format,

@@ -20,8 +20,9 @@ struct ViewpointOptions
 {
 	double min_distance_m = 0.8;  //!< horizontal distance to the landmark centre, lower bound [m]
 	double max_distance_m = 4.0;  //!< upper bound [m]
-	double max_view_angle_rad = 50.0 * M_PI / 180;  //!< |angle| from the landmark's normal [rad]
-	double max_bearing_rad = 0.15;  //!< |bearing| of the landmark centre from the optical axis [rad]
+	double max_view_angle_rad = 50.0 * M_PI / 180;	//!< |angle| from the landmark's normal [rad]
+	double max_bearing_rad =
+		0.15;  //!< |bearing| of the landmark centre from the optical axis [rad]
 	double camera_height_m = 0.6;  //!< height of the optical centre in the world [m]
 };
 

@@ -44,7 +44,7 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	cv::Scalar white_bgr{235, 235, 235};  //!< the sheet's white (quiet margin)
 	cv::Scalar green_bgr{0, 255, 0};  //!< fluorescent green: sRGB #00FF00
 
-	double gain = 1.0;  //!< illumination gain (multiplies all intensities)
+	double gain = 1.0;	//!< illumination gain (multiplies all intensities)
 	/** Relative gain change across the image along gradient_angle_rad:
 	 * the gain grows linearly from gain * (1 - gradient/2) to
 	 * gain * (1 + gradient/2) (0.5: +-25% from the centre); |gradient| < 2. */
@@ -54,7 +54,7 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	double gradient_angle_rad = 0.0;
 
 	double noise_sigma = 0.0;  //!< Gaussian pixel noise [grey levels]
-	double blur_sigma_px = 0.0;  //!< Gaussian blur [px]
+	double blur_sigma_px = 0.0;	 //!< Gaussian blur [px]
 	double motion_blur_px = 0.0;  //!< length of linear motion blur [px]
 	/** Direction of the motion, counter-clockwise from +u as displayed [rad]. */
 	double motion_blur_angle_rad = 0.0;
@@ -109,21 +109,23 @@ struct LandmarkTruth
 	 * likewise v), and seen from the front side. Geometric: occlusion by
 	 * another landmark or by the occluder bar does not change it. */
 	bool fully_visible = false;
-	bool in_front = false;  //!< the landmark centre is in front of the camera
+	bool in_front = false;	//!< the landmark centre is in front of the camera
 	bool facing = false;  //!< the camera is on the printed side
-	double occluded_fraction = 0;  //!< fraction of the reference square behind the occluder bar, as rendered
-	double area_px = 0;  //!< area of the reference square in the image (raw corners) [px^2]; 0 unless all corners are in front
+	double occluded_fraction =
+		0;	//!< fraction of the reference square behind the occluder bar, as rendered
+	double area_px = 0;	 //!< area of the reference square in the image (raw corners) [px^2]; 0
+						 //!< unless all corners are in front
 	/** Exact primary measurement (primaryMeasurementFromIdeal of
 	 * corners_ideal_px); zero unless all corners are in front. */
 	Eigen::Vector4d P = Eigen::Vector4d::Zero();
-	SightingTruth sighting;  //!< L and the camera's planar pose in frame L
-	mrpt::poses::CPose3D landmark_T_camera;  //!< exact 6-DoF pose
+	SightingTruth sighting;	 //!< L and the camera's planar pose in frame L
+	mrpt::poses::CPose3D landmark_T_camera;	 //!< exact 6-DoF pose
 };
 
 /** One rendered image. */
 struct Render
 {
-	cv::Mat image;  //!< CV_8UC3, BGR, camera resolution
+	cv::Mat image;	//!< CV_8UC3, BGR, camera resolution
 	std::vector<LandmarkTruth> truth;  //!< one per map landmark, map order
 };
 
@@ -157,7 +159,7 @@ Background backgroundFromName(const std::string& name);
  * frame L, so sightingTruth() gives L = (d, bearing, a - bearing). Returns
  * world_T_camera (optical frame). */
 mrpt::poses::CPose3D levelCameraLookingAt(
-	const MapLandmark& landmark, double distance_m, double view_angle_rad,
-	double height_m = 0.0, double bearing_rad = 0.0);
+	const MapLandmark& landmark, double distance_m, double view_angle_rad, double height_m = 0.0,
+	double bearing_rad = 0.0);
 
 }  // namespace codemark::sim
