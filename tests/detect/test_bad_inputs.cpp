@@ -77,14 +77,14 @@ TEST(BadInputs, AppPrintsOneErrorLinePerBadInputAndFailsAtTheEnd)
 		fs::temp_directory_path() / ("codemark_detect_bad_" + std::to_string(getpid()));
 	fs::remove_all(dir);
 	fs::create_directories(dir);
-	const cv::Mat green(48, 64, CV_8UC3, cv::Scalar(0, 255, 0));
+	const cv::Mat green(480, 640, CV_8UC3, cv::Scalar(0, 255, 0));
 	ASSERT_TRUE(cv::imwrite((dir / "good.png").string(), green));
 	ASSERT_TRUE(
 		cv::imwrite((dir / "tiny.png").string(), cv::Mat(1, 1, CV_8UC3, cv::Scalar(0, 255, 0))));
 	ASSERT_TRUE(
-		cv::imwrite((dir / "grey.png").string(), cv::Mat(48, 64, CV_8UC1, cv::Scalar(128))));
+		cv::imwrite((dir / "grey.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(128))));
 	ASSERT_TRUE(cv::imwrite(
-		(dir / "deep.png").string(), cv::Mat(48, 64, CV_16UC3, cv::Scalar(0, 65535, 0))));
+		(dir / "deep.png").string(), cv::Mat(480, 640, CV_16UC3, cv::Scalar(0, 65535, 0))));
 	cv::Mat bgra;
 	cv::cvtColor(green, bgra, cv::COLOR_BGR2BGRA);
 	ASSERT_TRUE(cv::imwrite((dir / "alpha.png").string(), bgra));
@@ -105,9 +105,11 @@ TEST(BadInputs, AppPrintsOneErrorLinePerBadInputAndFailsAtTheEnd)
 	std::string line;
 	std::vector<std::string> lines;
 	while (std::getline(in, line)) lines.push_back(line);
-	// One line per input, in order; the unreadable ones are errors.
+	// One line per input, in order; the unreadable ones are errors, and so
+	// are images the camera (640x480 colour) cannot have taken: 1x1, grey,
+	// 16-bit. A 4-channel image of the camera's size is read as colour.
 	ASSERT_EQ(lines.size(), 8u);
-	const bool error[8] = {false, true, false, false, true, false, false, true};
+	const bool error[8] = {false, true, true, true, true, true, false, true};
 	for (size_t i = 0; i < lines.size(); ++i)
 	{
 		EXPECT_EQ(lines[i].find("\"error\"") != std::string::npos, error[i]) << lines[i];

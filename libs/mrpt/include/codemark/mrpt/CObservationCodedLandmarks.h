@@ -32,7 +32,10 @@ class CObservationCodedLandmarks : public mrpt::obs::CObservation
 	{
 		int32_t id = -1;  //!< landmark ID, 0..255
 		/** Reference points in raw image pixels, TL, TR, BR, BL. */
-		std::array<Eigen::Vector2d, 4> corners{};
+		// Eigen's default constructor leaves coefficients uninitialised: zero them.
+		std::array<Eigen::Vector2d, 4> corners{
+			Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+			Eigen::Vector2d::Zero()};
 		Eigen::Vector4d P = Eigen::Vector4d::Zero();  //!< [x1 y1 x2 y2] [px]
 		Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();	//!< covariance of P [px^2]
 		/** [l2 phi1 phi2]: horizontal range [m], bearing [rad], relative
