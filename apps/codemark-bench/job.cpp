@@ -17,6 +17,7 @@
 #include <set>
 
 #include "bench.h"
+#include "errors.h"
 
 namespace codemark::bench
 {
@@ -28,32 +29,6 @@ namespace
 double seconds(Clock::time_point a, Clock::time_point b)
 {
 	return std::chrono::duration<double>(b - a).count();
-}
-
-// One line of an exception: MRPT's carry a header, location and backtrace.
-// Control characters (e.g. from a corrupt file's bytes quoted in the
-// message) become '?'.
-std::string oneLineRaw(const std::exception& e);
-std::string oneLine(const std::exception& e)
-{
-	std::string s = oneLineRaw(e);
-	for (auto& c : s)
-		if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-	return s;
-}
-std::string oneLineRaw(const std::exception& e)
-{
-	std::string s = e.what();
-	const auto header = s.find("==== MRPT exception ====");
-	const std::string prefix = header == std::string::npos ? "" : s.substr(0, header);
-	const auto msg = s.find("Message:");
-	if (msg != std::string::npos)
-	{
-		std::string m = s.substr(msg + 8, s.find('\n', msg) - msg - 8);
-		m.erase(0, m.find_first_not_of(' '));
-		return prefix + m;
-	}
-	return s.substr(0, s.find('\n'));
 }
 
 // [localize] initial pose, as codemark-localize reads it
@@ -257,7 +232,7 @@ JobResult runJob(
 	}
 	catch (const std::exception& e)
 	{
-		r.error = oneLine(e);
+		r.error = app::printable(app::oneLine(e));
 	}
 	r.wall_s = seconds(t_start, Clock::now());
 	if (progress) progress(1.0);

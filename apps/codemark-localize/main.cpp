@@ -9,29 +9,10 @@
 #include <iostream>
 #include <memory>
 
+#include "errors.h"
 #include "live_view.h"
 #include "progress.h"
 #include "rawlog_check.h"
-
-namespace
-{
-// One line from an exception: MRPT's exceptions carry a header, the
-// location and a backtrace; keep any context before them and the message.
-std::string oneLine(const std::exception& e)
-{
-	std::string s = e.what();
-	const auto header = s.find("==== MRPT exception ====");
-	const std::string prefix = header == std::string::npos ? "" : s.substr(0, header);
-	const auto msg = s.find("Message:");
-	if (msg != std::string::npos)
-	{
-		std::string m = s.substr(msg + 8, s.find('\n', msg) - msg - 8);
-		m.erase(0, m.find_first_not_of(' '));
-		return prefix + m;
-	}
-	return s.substr(0, s.find('\n'));
-}
-}  // namespace
 
 int main(int argc, char** argv)
 {
@@ -156,7 +137,7 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "codemark-localize: " << oneLine(e) << "\n";
+		std::cerr << "codemark-localize: " << codemark::app::oneLine(e) << "\n";
 	}
 	return 1;
 }

@@ -5,31 +5,26 @@
  * which say nothing to a user and break the apps' contract of one line on
  * stderr that names what is wrong and where.
  */
-#include <sstream>
+#include <codemark/landmark/text.h>
+
+#include <exception>
 #include <string>
 
 namespace codemark::app
 {
-/** \a what on one line: the MRPT banner and call stack dropped, the
- * remaining lines joined with "; ". */
-inline std::string oneLine(const std::string& what)
+/** \a what on one line: the MRPT banner, location and call stack dropped,
+ * the remaining lines joined with "; " (codemark::oneLineMessage). */
+inline std::string oneLine(const std::string& what) { return oneLineMessage(what); }
+
+/** The same for an exception's what(). */
+inline std::string oneLine(const std::exception& e) { return oneLineMessage(e.what()); }
+
+/** \a s with control characters (e.g. a corrupt file's bytes quoted in an
+ * error message) replaced by '?', for one-line reports and CSV cells. */
+inline std::string printable(std::string s)
 {
-	std::string msg = what;
-	const auto stack = msg.find("Call stack backtrace");
-	if (stack != std::string::npos) msg.resize(stack);
-	std::string out, line;
-	std::istringstream in(msg);
-	while (std::getline(in, line))
-	{
-		while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-		if (line.empty() || line.find("==== MRPT exception ====") != std::string::npos ||
-			line.find("==== non-MRPT exception ====") != std::string::npos)
-			continue;
-		// MRPT: "Message:  WHAT" then "Location: FILE:LINE: [function]": keep WHAT.
-		if (line.rfind("Location:", 0) == 0) continue;
-		if (line.rfind("Message:", 0) == 0) line = line.substr(line.find_first_not_of(" ", 8));
-		out += (out.empty() ? "" : "; ") + line;
-	}
-	return out.empty() ? what : out;
+	for (auto& c : s)
+		if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+	return s;
 }
 }  // namespace codemark::app

@@ -393,6 +393,28 @@ void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::s
 	j << summaryJson(s);
 }
 
+void addLandmarkErrors(
+	PathMetrics& m, const std::vector<MappedLandmark>& estimated, const LandmarkMap& truth)
+{
+	double se = 0, syaw = 0;
+	int n = 0;
+	for (const auto& l : estimated)
+		for (const auto& t : truth.landmarks)
+			if (t.id == l.landmark.id)
+			{
+				const auto p =
+					m.truth_T_estimate + mrpt::poses::CPoint2D(l.landmark.x_m, l.landmark.y_m);
+				se += std::pow(p.x() - t.x_m, 2) + std::pow(p.y() - t.y_m, 2);
+				syaw += std::pow(
+					mrpt::math::wrapToPi(l.landmark.yaw_rad + m.truth_T_estimate.phi() - t.yaw_rad),
+					2);
+				++n;
+			}
+	m.landmarks_matched = n;
+	m.landmark_rmse_m = n ? std::sqrt(se / n) : 0.0;
+	m.landmark_yaw_rmse_deg = n ? std::sqrt(syaw / n) * 180.0 / M_PI : 0.0;
+}
+
 LocalizeSummary runLocalization(
 	const LocalizeRequest& req, const std::function<void(double)>& progress,
 	const StepObserver& on_step)
@@ -487,25 +509,7 @@ LocalizeSummary runLocalization(
 	if (s.metrics && slam && !req.gt_map_file.empty())
 	{
 		// Landmark errors against the true map, in the same alignment.
-		const LandmarkMap truth_map = loadAnyMap(req.gt_map_file);
-		double se = 0, syaw = 0;
-		int n = 0;
-		for (const auto& l : s.slam_map)
-			for (const auto& t : truth_map.landmarks)
-				if (t.id == l.landmark.id)
-				{
-					const auto p = s.metrics->truth_T_estimate +
-								   mrpt::poses::CPoint2D(l.landmark.x_m, l.landmark.y_m);
-					se += std::pow(p.x() - t.x_m, 2) + std::pow(p.y() - t.y_m, 2);
-					syaw += std::pow(
-						mrpt::math::wrapToPi(
-							l.landmark.yaw_rad + s.metrics->truth_T_estimate.phi() - t.yaw_rad),
-						2);
-					++n;
-				}
-		s.metrics->landmarks_matched = n;
-		s.metrics->landmark_rmse_m = n ? std::sqrt(se / n) : 0.0;
-		s.metrics->landmark_yaw_rmse_deg = n ? std::sqrt(syaw / n) * 180.0 / M_PI : 0.0;
+		addLandmarkErrors(*s.metrics, s.slam_map, loadAnyMap(req.gt_map_file));
 	}
 	if (!req.out_dir.empty()) writeOutputs(s, map, req.out_dir);
 	return s;

@@ -97,8 +97,13 @@ std::string oneLineMessage(const std::string& what)
 	std::istringstream lines(msg);
 	for (std::string l; std::getline(lines, l);)
 	{
+		// A banner ("==== MRPT exception ====") may follow a prefix on the
+		// same line (a caller's "entry 12: " before MRPT's text): keep that.
+		if (const auto banner = l.find("===="); banner != std::string::npos &&
+												 l.find("exception ====") != std::string::npos)
+			l.resize(banner);
 		l = trim(l);
-		if (l.empty() || l.find("exception ====") != std::string::npos) continue;
+		if (l.empty()) continue;
 		if (l.rfind("Location:", 0) == 0) continue;
 		if (l.rfind("Message:", 0) == 0) l = trim(l.substr(8));
 		joined += (joined.empty() ? "" : "; ") + l;

@@ -112,6 +112,13 @@ struct LocalizeSummary
  * estimate (its covariance rotated with it) with the truth. */
 std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool align_se2 = false);
 
+/** Fills \a m's landmark errors (landmark_rmse_m, landmark_yaw_rmse_deg,
+ * landmarks_matched) of the \a estimated SLAM map against \a truth, matched
+ * by ID, through \a m's truth_T_estimate (identity when not aligned). The
+ * yaw error means nothing for point landmarks. */
+void addLandmarkErrors(
+	PathMetrics& m, const std::vector<MappedLandmark>& estimated, const LandmarkMap& truth);
+
 /** The SE(2) least-squares alignment b_T_a of 2D points \a a onto \a b
  * (pairs, at least one): closed form (Horn 1987 / Umeyama 1991 in the
  * plane, no scale). */

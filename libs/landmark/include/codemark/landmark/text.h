@@ -52,7 +52,8 @@ void requireIniNumbers(
 std::string iniWhere(const std::string& file, const std::string& section, const std::string& key);
 
 /** An exception message on one line: MRPT's banner, "Location:" line and
- * call stack dropped, the remaining lines joined with "; ". */
+ * call stack dropped (text before a banner on its line kept), the remaining
+ * lines joined with "; ". */
 std::string oneLineMessage(const std::string& what);
 
 /** Call inside a catch block around the loading of the ini \a file:
