@@ -16,13 +16,14 @@ namespace
 {
 LocalizeSummary runOn(
 	bool obs_only, int max_frames, const std::string& method, const std::string& ini,
-	bool slam_no_map = false)
+	bool slam_no_map = false, uint64_t seed = 3)
 {
 	sim::DatasetOptions o;
 	o.odometry_scale_error = 0.03;
-	o.seed = 3;
+	o.seed = seed;
 	const auto dir = fs::temp_directory_path() /
-					 ("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao"));
+					 ("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao") +
+					  "_seed" + std::to_string(seed));
 	if (!fs::exists(dir / "dataset.rawlog"))
 		sim::writeDataset(o, dir.string(), obs_only, {}, max_frames);
 	LocalizeRequest req;
@@ -35,47 +36,82 @@ LocalizeSummary runOn(
 	return runLocalization(req);
 }
 
-// Known shortfall (docs/benchmarks/filters.md): on this dataset (seed 3)
-// the ATE is about 4 cm (5 cm observations-only) against the issue's 3 cm:
-// the first fix, from one landmark 4 m away whose phi2 is good to ~13 deg,
-// is 24 cm off (inside its covariance), which alone adds 2.2 cm to the RMS.
-// The mean NEES is about 1.9 (1.6 observations-only), below the 95% band:
-// the pipeline's calibrated C_L is conservative on these renders (phi2's
-// normalised squared error averages about 0.1, the whole L's d2 about 2.5
-// against 3); the filters pass that on honestly rather than rescale it.
-// \a nees_factor widens the band by a factor on both sides, so the test
-// still fails on overconfidence (the plain EKF's one linearisation gave 15)
-// or on covariances inflated further.
-void expectConsistent(const LocalizeSummary& s, double max_ate_m, double nees_factor)
+void print(const LocalizeSummary& s)
 {
-	ASSERT_TRUE(s.metrics);
 	const auto& m = *s.metrics;
-	EXPECT_EQ(
-		s.first_fix_step, 0);  // first fix at the first sighting (landmarks in view at the start)
-	EXPECT_EQ(m.matched, s.steps);
-	EXPECT_LE(m.ate_rmse_m, max_ate_m);
-	EXPECT_GT(m.nees_mean, m.nees_band_low / nees_factor)
-		<< "mean NEES below the 95% band: too pessimistic";
-	EXPECT_LT(m.nees_mean, m.nees_band_high * nees_factor)
-		<< "mean NEES above the 95% band: overconfident";
-	EXPECT_GT(s.sightings_used, s.steps / 2);
 	std::cout << s.method << ": " << s.steps << " steps, ATE " << m.ate_rmse_m << " m, max "
 			  << m.max_error_m << " m, yaw RMSE " << m.yaw_rmse_deg << " deg, NEES " << m.nees_mean
 			  << " in [" << m.nees_band_low << ", " << m.nees_band_high << "], used "
 			  << s.sightings_used << ", rejected " << s.sightings_rejected << "\n";
 }
+
+void expectCommon(const LocalizeSummary& s)
+{
+	ASSERT_TRUE(s.metrics);
+	// First fix at the first sighting (landmarks are in view at the start).
+	EXPECT_EQ(s.first_fix_step, 0);
+	EXPECT_EQ(s.metrics->matched, s.steps);
+	EXPECT_GT(s.sightings_used, s.steps / 2);
+	print(s);
+}
+
+/** Issue 6's simulated-data targets for \a method over the seeds of the
+ * filters benchmark (bench/filters_sim: seeds 1-3 of codemark-simul's room
+ * loop, 5 Hz images, 3% odometry scale error, global initialisation): mean
+ * ATE <= \a max_ate_m and each run's mean NEES inside its two-sided 95%
+ * band (chi2inv(0.025 / 0.975, 3 N) / N over its N steps, as the benchmark
+ * counts "NEES in band"), \a nees_factor widening it on both sides (1: the
+ * target). */
+void expectTargetsOverSeeds(
+	const std::string& method, const std::string& ini, double max_ate_m, double nees_factor)
+{
+	double ate = 0;
+	int seeds = 0;
+	for (uint64_t seed = 1; seed <= 3; ++seed, ++seeds)
+	{
+		const LocalizeSummary s = runOn(false, 0, method, ini, false, seed);
+		expectCommon(s);
+		if (!s.metrics) return;
+		const auto& m = *s.metrics;
+		ate += m.ate_rmse_m;
+		EXPECT_GT(m.nees_mean, m.nees_band_low / nees_factor)
+			<< method << " seed " << seed << ": mean NEES below the 95% band: pessimistic";
+		EXPECT_LT(m.nees_mean, m.nees_band_high * nees_factor)
+			<< method << " seed " << seed << ": mean NEES above the 95% band: overconfident";
+	}
+	std::cout << method << " over " << seeds << " seeds: mean ATE " << ate / seeds << " m\n";
+	EXPECT_LE(ate / seeds, max_ate_m) << method;
+}
 }  // namespace
 
-TEST(FiltersSim, EkfAndEkfPoseFullLoopActionsObservations)
+// Issue 6's target on the benchmark's datasets: EKF ATE <= 3 cm, mean NEES
+// inside the 95% band, first fix at the first sighting.
+TEST(FiltersSim, EkfMeetsTheTargetsOnTheBenchmarkLoops)
 {
-	expectConsistent(runOn(false, 0, "ekf", "ekf.ini"), 0.045, 1.6);
-	expectConsistent(runOn(false, 0, "ekf-pose", "ekf-pose.ini"), 0.045, 1.6);
+	expectTargetsOverSeeds("ekf", "ekf.ini", 0.030, 1.0);
+}
+
+// The paper's pose-fix EKF on the same loops: as accurate; its NEES is
+// somewhat below the band (C_R of the closed form, taken to second order,
+// is conservative on these renders: 2.26-2.36 against [2.57, 3.46]), so the
+// band is widened by 1.25 on both sides; overconfidence still fails.
+TEST(FiltersSim, EkfPoseOnTheBenchmarkLoops)
+{
+	expectTargetsOverSeeds("ekf-pose", "ekf-pose.ini", 0.030, 1.25);
 }
 
 TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 {
-	// Odometry noise drawn per 20 Hz reading, interpolated to 5 Hz images.
-	expectConsistent(runOn(true, 50, "ekf", "ekf.ini"), 0.06, 1.7);
+	// Odometry noise drawn per 20 Hz reading (four draws per image interval
+	// instead of one), interpolated to 5 Hz images: the whole loop of seed 3
+	// gives ATE 3.6 cm (3.1 cm in the actions-observations format, where the
+	// same seed draws one increment per image), NEES inside the band.
+	const LocalizeSummary s = runOn(true, 0, "ekf", "ekf.ini");
+	expectCommon(s);
+	ASSERT_TRUE(s.metrics);
+	EXPECT_LE(s.metrics->ate_rmse_m, 0.04);
+	EXPECT_GT(s.metrics->nees_mean, s.metrics->nees_band_low);
+	EXPECT_LT(s.metrics->nees_mean, s.metrics->nees_band_high);
 }
 
 // EKF-SLAM from scratch (no map) on the rendered loop: almost nothing gated,
