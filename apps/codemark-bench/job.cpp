@@ -1,5 +1,6 @@
 // codemark-bench: one job = one dataset through one method, and the metrics
 // libs/filters does not compute (RPE, aligned ATE, detection rate).
+#include <codemark/landmark/random.h>
 #include <codemark/filters/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/stepper.h>
@@ -155,7 +156,7 @@ JobResult runJob(
 	const auto t_start = Clock::now();
 	try
 	{
-		if (seed) mrpt::random::getRandomGenerator().randomize(*seed);
+		if (seed) reseedMrptRandom(*seed);
 		const std::string ini = cfg.config_dir + "/" + method + ".ini";
 		mrpt::config::CConfigFile mcfg(ini);
 		auto& s = r.summary;

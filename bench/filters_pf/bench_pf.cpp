@@ -7,6 +7,7 @@
 //  2. The particle filter localizer (shipped pf.ini) from a uniform start:
 //     frames with sightings until the position error is < 10 cm (and the
 //     estimate reports itself initialized), over several seeds.
+#include <codemark/landmark/random.h>
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -94,7 +95,7 @@ int main(int argc, char** argv)
 {
 	const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
 	namespace pft = codemark::pftest;
-	mrpt::random::getRandomGenerator().randomize(1);
+	codemark::reseedMrptRandom(1);
 	const auto room = pft::room();
 	const mrpt::poses::CPose2D truth(2.2, 1.7, 0.3);
 	std::mt19937 rng(1);

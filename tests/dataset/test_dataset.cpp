@@ -9,6 +9,7 @@
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/random/RandomGenerators.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 #include <mrpt/config/CConfigFile.h>
@@ -161,6 +162,10 @@ TEST(Dataset, DeterministicForASeed)
 	o.render.noise_sigma = 2;
 	const auto a = tempDir("da"), b = tempDir("db");
 	writeDataset(o, a, false, {}, 5);
+	// Whatever the process drew before must not matter: one Gaussian draw
+	// leaves MRPT's generator with a saved second value, which its
+	// randomize(seed) alone does not clear (codemark::reseedMrptRandom).
+	mrpt::random::getRandomGenerator().drawGaussian1D_normalized();
 	writeDataset(o, b, false, {}, 5);
 	auto slurp = [](const std::string& p)
 	{
@@ -177,6 +182,13 @@ TEST(Dataset, DeterministicForASeed)
 	const auto c = tempDir("dc");
 	writeDataset(o, c, false, {}, 5);
 	EXPECT_NE(slurp(a + "/dataset.rawlog"), slurp(c + "/dataset.rawlog"));
+	// The same in the observations-only format (odometry at its own rate).
+	o.seed = 3;
+	const auto d = tempDir("dd"), e = tempDir("de");
+	writeDataset(o, d, true, {}, 5);
+	mrpt::random::getRandomGenerator().drawGaussian1D_normalized();
+	writeDataset(o, e, true, {}, 5);
+	EXPECT_EQ(slurp(d + "/dataset.rawlog"), slurp(e + "/dataset.rawlog"));
 }
 
 TEST(Dataset, TrajectoryFileErrorsNameTheLine)

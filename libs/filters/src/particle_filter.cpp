@@ -1,5 +1,6 @@
 // The particle filter localizer: MRPT's CMonteCarloLocalization2D and
 // CParticleFilter over the coded-landmark map (particle_filter.h).
+#include <codemark/landmark/random.h>
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <codemark/pose/closed_form.h>
@@ -140,7 +141,7 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(
 			"method 'pf': [PF_options] PF_algorithm=2 (pfOptimalProposal) is not offered by "
 			"CMonteCarloLocalization2D; use 0, 1 or 3");
 	if (m_opts.random_seed >= 0)
-		mrpt::random::getRandomGenerator().randomize(static_cast<uint32_t>(m_opts.random_seed));
+		reseedMrptRandom(static_cast<uint32_t>(m_opts.random_seed));
 	m_pdf.options.metricMap = m_map;
 
 	const auto N = static_cast<size_t>(m_opts.particles_count);

@@ -1,3 +1,4 @@
+#include <codemark/landmark/random.h>
 #include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -387,7 +388,7 @@ DatasetSummary writeDataset(
 	if (!mrpt::system::directoryExists(img_dir) && !mrpt::system::createDirectory(img_dir))
 		throw std::runtime_error(img_dir + ": cannot create image directory");
 
-	mrpt::random::getRandomGenerator().randomize(o.seed);
+	reseedMrptRandom(o.seed);
 	const Trajectory trajectory(o);
 	auto frames = trajectory.sample(o.frame_rate_hz, 0.0);
 	if (max_frames > 0 && frames.size() > static_cast<std::size_t>(max_frames))
