@@ -124,6 +124,9 @@ LocalizeSummary runKfSlam(
 {
 	mrpt::slam::CRangeBearingKFSLAM2D kf;
 	kf.loadOptions(cfg);
+	// The ini turns kf-slam's profiler on (its time per step); here it would
+	// print its report on stdout, into the Markdown.
+	kf.KF_options.enable_profiler = false;
 	kf.setVerbosityLevel(mrpt::system::LVL_ERROR);
 	LocalizeSummary s;
 	s.method = "kf-slam";
