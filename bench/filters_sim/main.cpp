@@ -6,6 +6,7 @@
 // scripts/bench-filters.sh). Images are detected once per dataset and every
 // filter runs on the same steps.
 #include <codemark/filters/ekf.h>
+#include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
@@ -152,18 +153,12 @@ LocalizeSummary runKfSlam(
 		++s.steps;
 	}
 	s.time_per_step_ms = 1000 * secs / std::max<long>(1, s.steps);
-	mrpt::poses::CPosePDFGaussian pose;
-	std::vector<mrpt::math::TPoint2D> pts;
-	std::map<unsigned int, mrpt::maps::CLandmark::TLandmarkID> ids;
-	mrpt::math::CVectorDouble x;
-	mrpt::math::CMatrixDouble P;
-	kf.getCurrentState(pose, pts, ids, x, P);
-	for (std::size_t i = 0; i < pts.size(); ++i)
+	for (const auto& [id, xy] : rangeBearingSlamLandmarks(kf))
 	{
 		MappedLandmark l;
-		l.landmark.id = static_cast<int>(ids[static_cast<unsigned>(i)]);
-		l.landmark.x_m = pts[i].x;
-		l.landmark.y_m = pts[i].y;
+		l.landmark.id = id;
+		l.landmark.x_m = xy.x();
+		l.landmark.y_m = xy.y();
 		s.slam_map.push_back(l);
 	}
 	s.metrics = computeMetrics(s.rows, true);
@@ -350,7 +345,8 @@ int main(int argc, char** argv)
 				const std::string kf_ini = share.getValue() + "/kf-slam-codemark.ini";
 				if (!phi2_table || !fs::exists(slam_ini) || !fs::exists(kf_ini)) continue;
 				mrpt::config::CConfigFile slam_cfg(slam_ini), kf_cfg(kf_ini);
-				if (steps.empty()) steps = readSteps((dir / "dataset.rawlog").string(), slam_cfg, ds.map);
+				if (steps.empty())
+					steps = readSteps((dir / "dataset.rawlog").string(), slam_cfg, ds.map);
 				const auto twin = bearingRangeTwin(steps);
 				slam_rows[{nz.name, "codemark ekf-slam, coded sightings (L with phi2)"}].add(
 					runSteps(steps, "ekf-slam", slam_cfg, LandmarkMap(), ds, true), true);

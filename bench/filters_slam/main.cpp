@@ -150,16 +150,7 @@ Result runMrpt(
 	Result r;
 	r.steps = path.size();
 	r.path_rmse = rmsePath(path, gt_path);
-	mrpt::poses::CPosePDFGaussian pose;
-	std::vector<mrpt::math::TPoint2D> pts;
-	std::map<unsigned int, mrpt::maps::CLandmark::TLandmarkID> ids;
-	mrpt::math::CVectorDouble x;
-	mrpt::math::CMatrixDouble P;
-	kf.getCurrentState(pose, pts, ids, x, P);
-	std::map<int, Eigen::Vector2d> lms;
-	for (std::size_t i = 0; i < pts.size(); ++i)
-		lms[static_cast<int>(ids[static_cast<unsigned>(i)])] = Eigen::Vector2d(pts[i].x, pts[i].y);
-	landmarkErrors(lms, gt_map, r);
+	landmarkErrors(rangeBearingSlamLandmarks(kf), gt_map, r);
 	r.step_ms = total / std::max<std::size_t>(1, r.steps);
 	r.kf_ms = 1e3 * kf.getProfiler().getMeanTime("KF:complete_step");
 	return r;

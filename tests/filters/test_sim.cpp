@@ -21,9 +21,9 @@ LocalizeSummary runOn(
 	sim::DatasetOptions o;
 	o.odometry_scale_error = 0.03;
 	o.seed = seed;
-	const auto dir = fs::temp_directory_path() /
-					 ("codemark_test_sim_" + std::to_string(getpid()) + (obs_only ? "_oo" : "_ao") +
-					  "_seed" + std::to_string(seed));
+	const auto dir =
+		fs::temp_directory_path() / ("codemark_test_sim_" + std::to_string(getpid()) +
+									 (obs_only ? "_oo" : "_ao") + "_seed" + std::to_string(seed));
 	if (!fs::exists(dir / "dataset.rawlog"))
 		sim::writeDataset(o, dir.string(), obs_only, {}, max_frames);
 	LocalizeRequest req;

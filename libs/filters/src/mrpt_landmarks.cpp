@@ -85,4 +85,19 @@ bool isMrptLandmarksFile(const std::string& path)
 	return false;
 }
 
+std::map<int, Eigen::Vector2d> rangeBearingSlamLandmarks(
+	const mrpt::slam::CRangeBearingKFSLAM2D& kf)
+{
+	mrpt::poses::CPosePDFGaussian pose;
+	std::vector<mrpt::math::TPoint2D> pts;
+	std::map<unsigned int, mrpt::maps::CLandmark::TLandmarkID> ids;
+	mrpt::math::CVectorDouble x;
+	mrpt::math::CMatrixDouble P;
+	kf.getCurrentState(pose, pts, ids, x, P);
+	std::map<int, Eigen::Vector2d> out;
+	for (std::size_t i = 0; i < pts.size(); ++i)
+		out[static_cast<int>(ids[static_cast<unsigned>(i)])] = Eigen::Vector2d(pts[i].x, pts[i].y);
+	return out;
+}
+
 }  // namespace codemark::filters

@@ -140,8 +140,7 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(
 		throw std::invalid_argument(
 			"method 'pf': [PF_options] PF_algorithm=2 (pfOptimalProposal) is not offered by "
 			"CMonteCarloLocalization2D; use 0, 1 or 3");
-	if (m_opts.random_seed >= 0)
-		reseedMrptRandom(static_cast<uint32_t>(m_opts.random_seed));
+	if (m_opts.random_seed >= 0) reseedMrptRandom(static_cast<uint32_t>(m_opts.random_seed));
 	m_pdf.options.metricMap = m_map;
 
 	const auto N = static_cast<size_t>(m_opts.particles_count);

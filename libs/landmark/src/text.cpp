@@ -99,8 +99,8 @@ std::string oneLineMessage(const std::string& what)
 	{
 		// A banner ("==== MRPT exception ====") may follow a prefix on the
 		// same line (a caller's "entry 12: " before MRPT's text): keep that.
-		if (const auto banner = l.find("===="); banner != std::string::npos &&
-												 l.find("exception ====") != std::string::npos)
+		if (const auto banner = l.find("====");
+			banner != std::string::npos && l.find("exception ====") != std::string::npos)
 			l.resize(banner);
 		l = trim(l);
 		if (l.empty()) continue;

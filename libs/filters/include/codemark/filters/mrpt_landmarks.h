@@ -10,6 +10,10 @@
  * and blank lines are comments.
  */
 #include <codemark/landmark/map.h>
+#include <mrpt/slam/CRangeBearingKFSLAM2D.h>
+
+#include <Eigen/Core>
+#include <map>
 
 #include <iosfwd>
 #include <string>
@@ -31,5 +35,10 @@ LandmarkMap parseMrptLandmarks(std::istream& in, const std::string& name);
  * map (spec section 3): its first non-comment line has 7 columns. Lets tools
  * accept both with one --map option. False when the file cannot be read. */
 bool isMrptLandmarksFile(const std::string& path);
+
+/** The point landmarks of MRPT's CRangeBearingKFSLAM2D (stock kf-slam's
+ * filter) by landmark ID: (x, y) [m] in its map frame. */
+std::map<int, Eigen::Vector2d> rangeBearingSlamLandmarks(
+	const mrpt::slam::CRangeBearingKFSLAM2D& kf);
 
 }  // namespace codemark::filters
