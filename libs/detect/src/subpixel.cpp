@@ -9,6 +9,11 @@ namespace codemark::detect
 {
 namespace
 {
+/** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
+ * model when the three samples give none: a Gaussian edge blur of about
+ * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
+constexpr double kLobeSeedVarPx2 = 0.7;
+
 /** The peak of three samples a, b, c at -1, 0, 1 (b the largest): a
  * Gaussian through them (log-parabola), or a parabola where the logarithm
  * is undefined. Returns the offset and, for the Gaussian, its variance
@@ -61,6 +66,14 @@ std::optional<double> locateRisingEdge(
 		// that of the peak, its height from the samples at the neighbour,
 		// less this peak's tail there) and fit again, a few times.
 		const int ko = static_cast<int>(std::lround(e - neighbour_px));
+		// A lobe strong enough to make the outer neighbour sample negative
+		// (a frame under ~1.8 px against a bright wall) leaves the
+		// log-parabola without a width, precisely where the pull is largest
+		// (0.3-0.5 px at 5 m and 60 deg): seed the lobe model with a typical
+		// width instead; its iterations re-estimate the width from the
+		// corrected samples (the result moves by < 0.005 px for seeds of 0.5
+		// to 0.9 px^2).
+		if (neighbour_px > 0 && var <= 0) var = kLobeSeedVarPx2;
 		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < peak)
 		{
 			int lowest = d(ko);
