@@ -417,7 +417,8 @@ TEST(Subpixel, PeakModeRemovesMostOfTheOuterEdgeOfAThinFrame)
 				for (double x0 = 9.0; x0 < 10.0; x0 += 0.05)
 				{
 					const auto v = thinFrameProfile(x0, width, blur, wall, 21);
-					const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::Peak, width);
+					const auto e =
+						locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::Peak, width);
 					const auto e0 = locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::Peak);
 					ASSERT_TRUE(e && e0);
 					with = std::max(with, std::abs(*e - x0));
@@ -431,7 +432,9 @@ TEST(Subpixel, PeakModeRemovesMostOfTheOuterEdgeOfAThinFrame)
 					EXPECT_LE(with, 0.35) << what;
 				}
 				else if (wall >= 150)
+				{
 					EXPECT_LT(with, 0.75 * without) << what;
+				}
 			}
 }
 

@@ -66,7 +66,8 @@ DetectionResult detect(
 
 		// 5. Segment selection: size, polarity, slimness, relative length.
 		const auto sides = selectSegments(
-			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr);
+			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr,
+			(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m));
 		tm.segments_us += microsSince(t);
 		if (debug) dbg.edgels.push_back(std::move(edgels));
 		if (!sides) continue;

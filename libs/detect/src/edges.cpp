@@ -138,7 +138,7 @@ EdgelMap findEdgels(
 
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p, const cv::Mat* bgr)
+	const SegmentParams& p, const cv::Mat* bgr, double fill_band_rel)
 {
 	// The fill's colour in the image just inside a domain, at two of three
 	// points along it: 1.5 px inwards, 1 px beyond the edgel's rounding,
@@ -164,12 +164,15 @@ std::optional<SideSegments> selectSegments(
 	// two of three points along it? Rejects edges outside the frame (the
 	// sheet against the wall), which the fill's bounding box may come near
 	// when the codec smears the green over the thin frame.
-	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward)
+	const auto fillInside = [&](const EdgelDomain& d, const Eigen::Vector2d& inward, double band_px)
 	{
 		int hits = 0;
 		// The domain's position is known to half a pixel of its gradient
-		// image.
-		const double reach = std::max(2.0, step + 1.0) + 0.5 * (d.pixel_px - 1);
+		// image. A grid cell and more inwards, but within the green band
+		// before the code board (2.8 px wide at 5 m and 60 deg, where a
+		// black code cell 3 px inwards used to hide the fill).
+		const double reach = std::min(std::max(2.0, step + 1.0), std::max(1.5, 0.6 * band_px)) +
+							 0.5 * (d.pixel_px - 1);
 		for (const double t : {-0.25, 0.0, 0.25})
 		{
 			const Eigen::Vector2d q = d.mean + t * d.length_px * d.dir + reach * inward;
@@ -210,7 +213,9 @@ std::optional<SideSegments> selectSegments(
 				continue;
 			Eigen::Vector2d inward = Eigen::Vector2d::Zero();
 			inward(axis) = low_side ? 1 : -1;
-			if (!mask.empty() && !fillInside(d, inward)) continue;
+			// The fill's extent across this side: the bounding box's other size.
+			const double across = vertical_side ? c.bbox.width : c.bbox.height;
+			if (!mask.empty() && !fillInside(d, inward, fill_band_rel * across)) continue;
 			if (!fillInImage(d, inward)) continue;
 			const double dist = std::abs(d.mean(axis) - bbox_side);
 			if (dist < best_dist)

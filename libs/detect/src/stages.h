@@ -114,10 +114,15 @@ using SideSegments = std::array<EdgelDomain, 4>;
  * also be seen in the image right inside the domain (G at least half the
  * fill's, above R and B), 1.5 px plus half a gradient-image pixel inwards:
  * the grid mask is coarser, and the sheet's edge against a darker wall lies
- * only a thin frame (1.6-3.2 px at 5 m) outside the inner edge. */
+ * only a thin frame (1.6-3.2 px at 5 m) outside the inner edge.
+ * \a fill_band_rel is the green band between the inner edge and the code
+ * board over the reference square's side ((160 - 90) / 2 / 160 for the
+ * spec's landmark): the mask test looks no deeper than about half of it, so
+ * that a small or oblique landmark's black code cells next to the band do
+ * not hide the fill. */
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p, const cv::Mat* bgr = nullptr);
+	const SegmentParams& p, const cv::Mat* bgr = nullptr, double fill_band_rel = 35.0 / 160);
 
 // ------------------------------------------------------------------ stage 6
 /** Coarse corners TL, TR, BR, BL [raw px]. */
