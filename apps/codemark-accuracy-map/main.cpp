@@ -54,6 +54,11 @@ int main(int argc, char** argv)
 			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default "
 			"Fixed.",
 			false, "Fixed", "NAME", cmd);
+		TCLAP::SwitchArg paper_arg(
+			"", "paper-closed-form",
+			"The closed-form column uses the paper's formulas alone, without the weighted "
+			"least-squares refinement on P (PoseOptions::refine_on_primary, on by default).",
+			cmd, false);
 		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
 		TCLAP::ValueArg<unsigned long> seed_arg(
 			"", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
@@ -74,6 +79,7 @@ int main(int argc, char** argv)
 			o.noise_label = "constant sigma_px " + std::to_string(sigma_arg.getValue());
 		}
 		o.apriltag = !no_tag_arg.getValue();
+		if (paper_arg.getValue()) o.pose.refine_on_primary = false;
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
 			o.noise_label = "the detector's per-detection corner sigma";

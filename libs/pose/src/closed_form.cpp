@@ -84,6 +84,89 @@ Eigen::Matrix3d poseCovarianceSecondOrder(const Eigen::Vector3d& L, const Eigen:
 	return C;
 }
 
+Eigen::Vector4d primaryFromLandmark(
+	const Eigen::Vector3d& L, double lambda, double h, Eigen::Matrix<double, 4, 3>* J_L)
+{
+	const double l2 = L[0], c1 = std::cos(L[1]), s1 = std::sin(L[1]), c2 = std::cos(L[2]),
+				 s2 = std::sin(L[2]);
+	// Forward and left coordinates of the left (1) and right (2) edge centres.
+	const double f[2] = {l2 * c1 + h * s2, l2 * c1 - h * s2};
+	const double g[2] = {l2 * s1 + h * c2, l2 * s1 - h * c2};
+	if (!(f[0] > 0) || !(f[1] > 0) || !(lambda > 0))
+		throw std::invalid_argument("primaryFromLandmark: an edge is not in front of the camera");
+	Eigen::Vector4d P;
+	for (int i = 0; i < 2; ++i)
+	{
+		P[2 * i] = -lambda * g[i] / f[i];
+		P[2 * i + 1] = lambda * h / f[i];
+	}
+	if (J_L)
+	{
+		const double sgn[2] = {1, -1};
+		for (int i = 0; i < 2; ++i)
+		{
+			// d(f, g)/d(l2, phi1, phi2)
+			const double df[3] = {c1, -l2 * s1, sgn[i] * h * c2};
+			const double dg[3] = {s1, l2 * c1, -sgn[i] * h * s2};
+			for (int k = 0; k < 3; ++k)
+			{
+				(*J_L)(2 * i, k) = -lambda * (dg[k] * f[i] - g[i] * df[k]) / (f[i] * f[i]);
+				(*J_L)(2 * i + 1, k) = -lambda * h * df[k] / (f[i] * f[i]);
+			}
+		}
+	}
+	return P;
+}
+
+Eigen::Vector3d refineLandmarkOnPrimary(
+	const Eigen::Vector4d& P, const Eigen::Matrix4d& C_P, double lambda, double h,
+	const Eigen::Vector3d& L0, Eigen::Matrix3d* C_L)
+{
+	const Eigen::LLT<Eigen::Matrix4d> llt(C_P);
+	if (llt.info() != Eigen::Success)
+		throw std::invalid_argument("refineLandmarkOnPrimary: C_P is not positive definite");
+	const Eigen::Matrix4d W = llt.solve(Eigen::Matrix4d::Identity());
+	const auto cost = [&](const Eigen::Vector3d& L)
+	{
+		const Eigen::Vector4d r = P - primaryFromLandmark(L, lambda, h);
+		return r.dot(W * r);
+	};
+	Eigen::Vector3d L = L0;
+	Eigen::Matrix<double, 4, 3> J;
+	double c = cost(L);
+	for (int it = 0; it < 20; ++it)
+	{
+		const Eigen::Vector4d r = P - primaryFromLandmark(L, lambda, h, &J);
+		const Eigen::Vector3d step = (J.transpose() * W * J).ldlt().solve(J.transpose() * W * r);
+		// Halve the step while it does not lower the cost (or leaves the
+		// region where both edges are in front of the camera).
+		double applied = 0;
+		for (double t = 1; t > 1e-3 && applied == 0; t *= 0.5)
+		{
+			try
+			{
+				const double ct = cost(L + t * step);
+				if (ct <= c)
+				{
+					L += t * step;
+					c = ct;
+					applied = t * step.norm();
+				}
+			}
+			catch (const std::invalid_argument&)
+			{
+			}
+		}
+		if (applied < 1e-12 * (1 + L.norm())) break;
+	}
+	if (C_L)
+	{
+		primaryFromLandmark(L, lambda, h, &J);
+		*C_L = (J.transpose() * W * J).inverse();
+	}
+	return L;
+}
+
 Eigen::Matrix4d primaryCovariance(double sx, double sy)
 {
 	return Eigen::Vector4d(sx * sx, sy * sy, sx * sx, sy * sy).asDiagonal();

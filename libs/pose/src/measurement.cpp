@@ -91,6 +91,7 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(corr_growth_x12, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corr_growth_y12, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(second_order_pose_covariance, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(refine_on_primary, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lm_max_iterations, int, c, s);
 	validate();
@@ -130,6 +131,9 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 		s, "second_order_pose_covariance", second_order_pose_covariance, -1, -1,
 		"ClosedForm: C_R to second order in C_L");
 	c.write(
+		s, "refine_on_primary", refine_on_primary, -1, -1,
+		"closed form: refine L by weighted least squares on P with C_P");
+	c.write(
 		s, "min_sigma_px", min_sigma_px, -1, -1,
 		"Detector: floor of the sigma of a component of P [px]");
 	c.write(
@@ -168,6 +172,8 @@ Measurement measure(
 		Eigen::Matrix3d J_L;
 		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), &J_P);
 		m.C_L = J_P * m.C_P * J_P.transpose();
+		if (options.refine_on_primary)
+			m.L = refineLandmarkOnPrimary(m.P, m.C_P, lambda, geometry.innerHalf(), m.L, &m.C_L);
 		m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
 		m.C_R = options.second_order_pose_covariance
 					? poseCovarianceSecondOrder(m.L, m.C_L)

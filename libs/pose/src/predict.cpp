@@ -107,19 +107,14 @@ Prediction predictSighting(
 		// Exact pinhole + distortion, also outside the image (for the numbers).
 		pr.corners_px[i] = camera.distortNormalized({pc.x() / pc.z(), pc.y() / pc.z()});
 	}
-	Measurement& m = pr.measurement;
-	double lambda = 0;
-	m.method = PoseMethod::ClosedForm;
-	m.P = primaryMeasurement(pr.corners_px, camera, &lambda);
+	// The measurement the closed form would give from these exact corners,
+	// with the options' C_P (and refinement, C_R order): measure() itself.
+	PoseOptions closed_form = options;
+	closed_form.method = PoseMethod::ClosedForm;
+	pr.measurement = measure(pr.corners_px, camera, g, closed_form);
+	const Measurement& m = pr.measurement;
 	pr.size_px = 2 * std::min(m.P[1], m.P[3]);
 	pr.big_enough = pr.size_px >= vis.min_size_px;
-	m.C_P = options.primaryCovariance(m.P);
-	Eigen::Matrix<double, 3, 4> J_P;
-	Eigen::Matrix3d J_L;
-	m.L = landmarkFromPrimary(m.P, lambda, g.innerHalf(), &J_P);
-	m.C_L = J_P * m.C_P * J_P.transpose();
-	m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
-	m.C_R = J_L * m.C_L * J_L.transpose();
 
 	robotPoseInWorld(
 		m.pose_in_landmark, m.C_R, landmarkPlanarPose(world_T_landmark),

@@ -206,7 +206,8 @@ FigureScales drawUncertaintyFigure(
 		bool usable;
 	};
 	std::vector<Cell> cells;
-	double max_a95 = 0, max_wedge = 0;
+	double max_wedge = 0;
+	std::vector<double> a95s;
 	for (double X = o.x_min_m; X <= o.x_max_m + 1e-9; X += o.step_m)
 		for (double Y = -o.y_max_m; Y <= o.y_max_m + 1e-9; Y += o.step_m)
 		{
@@ -216,7 +217,7 @@ FigureScales drawUncertaintyFigure(
 			c.usable = c.u.in_image && c.u.size_px >= o.min_size_px;
 			if (c.usable)
 			{
-				max_a95 = std::max(max_a95, std::sqrt(kChi2_2dof_95) * c.u.sigma_position_m);
+				a95s.push_back(std::sqrt(kChi2_2dof_95) * c.u.sigma_position_m);
 				max_wedge = std::max(max_wedge, 1.96 * c.u.sigma_heading_rad);
 			}
 			cells.push_back(c);
@@ -229,8 +230,18 @@ FigureScales drawUncertaintyFigure(
 		const double f = v / p;
 		return p * (f >= 5 ? 5 : f >= 2 ? 2 : 1);
 	};
+	// Ellipses: three quarters of them fit between grid points; the few
+	// largest (seen squarely from afar, where phi2 is weakest) may overlap
+	// their neighbours rather than shrink every other ellipse to a dot.
+	double a95 = 0;
+	if (!a95s.empty())
+	{
+		const auto q = a95s.begin() + static_cast<std::ptrdiff_t>(0.75 * (a95s.size() - 1));
+		std::nth_element(a95s.begin(), q, a95s.end());
+		a95 = *q;
+	}
 	double mag = o.magnification;
-	if (!(mag > 0)) mag = round125(max_a95 > 0 ? 0.45 * o.step_m / max_a95 : 1.0);
+	if (!(mag > 0)) mag = round125(a95 > 0 ? 0.45 * o.step_m / a95 : 1.0);
 	double hmag = o.heading_magnification;
 	if (!(hmag > 0))
 		hmag = std::max(1.0, round125(max_wedge > 0 ? (20 * M_PI / 180) / max_wedge : 1.0));

@@ -47,8 +47,10 @@ namespace codemark::pipeline
  *   beyond 3 sigma, biased short at >= 2 m, test_annotate.cpp), so the
  *   larger common-mode model stays until the two sets agree.
  * Normalised variances on the calibration set: 0.98 (x, re-fit), 1.02 (y). The
- * closed form's C_R is taken to second order in C_L
- * (pose::poseCovarianceSecondOrder()). Checked on other renders and seeds
+ * closed form refines L by weighted least squares on P with this C_P
+ * (pose::refineLandmarkOnPrimary(): 5-10x smaller phi2 errors at 3-5 m,
+ * and a consistent C_L, docs/benchmarks/pose.md), and its C_R is taken to
+ * second order in C_L (pose::poseCovarianceSecondOrder()). Checked on other renders and seeds
  * by tests/pipeline/test_pose_nees.cpp and test_annotate.cpp. On a flat
  * grey background the detector is about twice as good (constant parts 0.010
  * and 0.0125 px): these values are conservative there. Re-run the

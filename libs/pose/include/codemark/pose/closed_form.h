@@ -33,6 +33,30 @@ Eigen::Vector3d landmarkFromPrimary(
 	const Eigen::Vector4d& P, double lambda_px, double h_m,
 	Eigen::Matrix<double, 3, 4>* J_P = nullptr);
 
+/** The inverse of landmarkFromPrimary(): the P = [x1 y1 x2 y2] that a
+ * landmark at L = [l2 phi1 phi2] gives (level camera, the vertical edges
+ * at the landmark centre -+ h along Y_L, each imaged at x_i = -lambda
+ * left_i / forward_i and y_i = lambda h / forward_i in the camera's
+ * horizontal (forward, left) frame). \param J_L if not null, receives the
+ * 4x3 Jacobian dP/dL. Throws std::invalid_argument when an edge is not in
+ * front of the camera. */
+Eigen::Vector4d primaryFromLandmark(
+	const Eigen::Vector3d& L, double lambda_px, double h_m,
+	Eigen::Matrix<double, 4, 3>* J_L = nullptr);
+
+/** L from P by weighted least squares: the closed form's four equations
+ * have three unknowns, and its formulas combine them unweighted (phi2 from
+ * y2 - y1 alone, wasting the square's foreshortened width x2 - x1, which
+ * carries most of phi2 at oblique views). Gauss-Newton on (P -
+ * primaryFromLandmark(L))^T C_P^-1 (P - primaryFromLandmark(L)) from \a L0
+ * (the closed form's L); P alone, so the same data as the paper's path.
+ * Returns L; \a C_L, if not null, receives (J^T C_P^-1 J)^-1, J = dP/dL at
+ * the solution (first order). Throws std::invalid_argument if C_P is not
+ * positive definite. */
+Eigen::Vector3d refineLandmarkOnPrimary(
+	const Eigen::Vector4d& P, const Eigen::Matrix4d& C_P, double lambda_px, double h_m,
+	const Eigen::Vector3d& L0, Eigen::Matrix3d* C_L = nullptr);
+
 /** The camera's planar pose in frame L from L (paper eq. 12-14 in the spec's
  * convention): x = l2 cos(phi1 + phi2), y = l2 sin(phi1 + phi2),
  * theta = pi + phi2 wrapped to (-pi, pi]. x, y [m] of the optical centre,

@@ -128,6 +128,13 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * instead of the spec's first order J_L C_L J_L^T. ini key
 	 * `second_order_pose_covariance`. */
 	bool second_order_pose_covariance = false;
+	/** Closed form: refine L by weighted least squares on P with C_P
+	 * (refineLandmarkOnPrimary(): the paper's formulas use P's four numbers
+	 * unweighted for three unknowns and waste the foreshortened width, which
+	 * carries most of phi2 at oblique views; about 5-10x smaller phi2 errors
+	 * at 3-5 m, docs/benchmarks/pose.md), C_L from the Fisher information.
+	 * Still P alone. ini key `refine_on_primary`. */
+	bool refine_on_primary = true;
 	/** General path: Levenberg-Marquardt iterations of each refinement. */
 	int lm_max_iterations = 30;
 
