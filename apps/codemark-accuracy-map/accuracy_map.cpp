@@ -4,6 +4,7 @@
 #include <codemark/landmark/truth.h>
 #include <codemark/pose/closed_form.h>
 #include <codemark/pose/general.h>
+#include <codemark/sim/dataset.h>
 #include <codemark/sim/render.h>
 
 extern "C"
@@ -241,7 +242,7 @@ std::vector<CellResult> runSurvey(
 	lm.z_m = 0.5;
 	scene.map.landmarks.push_back(lm);
 	scene.camera = camera;
-	sim::RenderOptions ro;
+	sim::RenderOptions ro = o.realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
 	ro.noise_sigma = o.noise_sigma;
 	ro.blur_sigma_px = o.blur_sigma_px;
 	const LandmarkGeometry g = lm.geometry();
@@ -508,7 +509,11 @@ std::string writeResults(
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
 	  << o.renders_per_cell << " renders each, noise " << fmt(o.noise_sigma, 1) << ", blur "
-	  << fmt(o.blur_sigma_px, 2) << " px, C_P " << o.noise_label << "\n";
+	  << fmt(o.blur_sigma_px, 2) << " px, C_P " << o.noise_label << ", "
+	  << (o.realistic ? "realistic scene (textured wall, light gradient, distractors)"
+					  : "plain background")
+	  << ", closed form " << (o.pose.refine_on_primary ? "refined on P" : "paper's formulas alone")
+	  << "\n";
 	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general "
 		 "6-DoF,"
 		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's "

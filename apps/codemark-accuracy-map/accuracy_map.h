@@ -36,6 +36,12 @@ struct SurveyOptions
 	/** A one-line description of \a pose's noise model for the summary. */
 	std::string noise_label = "calibrated (pipeline::detectorCalibratedPoseOptions)";
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path
+	/** Render codemark's landmark in the realistic scene of the C_P
+	 * calibration and the simulated datasets (sim::DatasetOptions::
+	 * realisticRender(): textured wall, light gradient, distractors) instead
+	 * of the paper's plain grey background; noise and blur as set. The
+	 * AprilTag renders keep the plain background. */
+	bool realistic = false;
 	uint64_t seed = 1;	//!< first render seed
 };
 

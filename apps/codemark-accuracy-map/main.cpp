@@ -59,6 +59,13 @@ int main(int argc, char** argv)
 			"The closed-form column uses the paper's formulas alone, without the weighted "
 			"least-squares refinement on P (PoseOptions::refine_on_primary, on by default).",
 			cmd, false);
+		TCLAP::SwitchArg realistic_arg(
+			"", "realistic",
+			"Render codemark's landmark in the realistic scene the C_P calibration was fitted "
+			"on (textured wall, light gradient, distractors) instead of the plain background "
+			"(the AprilTag renders keep theirs; use with --no-apriltag for a like-for-like "
+			"comparison).",
+			cmd, false);
 		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
 		TCLAP::ValueArg<unsigned long> seed_arg(
 			"", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
@@ -80,6 +87,7 @@ int main(int argc, char** argv)
 		}
 		o.apriltag = !no_tag_arg.getValue();
 		if (paper_arg.getValue()) o.pose.refine_on_primary = false;
+		o.realistic = realistic_arg.getValue();
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
 			o.noise_label = "the detector's per-detection corner sigma";
