@@ -54,20 +54,22 @@ Notes on the simulated section:
   detector's validated range). The EKF ("ekf") uses the iterated update
   (`[ekf] iterations = 10`). ekf-slam runs with the true map as its prior.
 - Issue 6's targets on the default renders (noise 2, blur 0.8 px): EKF
-  ATE <= 3 cm over the seeds, its mean NEES inside the 95% band in every
-  run, first fix at the first frame; tests/filters/test_sim.cpp checks the
-  same on the same seeds. The largest errors are the first fix (one
-  landmark 4 m away, frontal, whose phi2 carries a few degrees: 12-22 cm,
-  inside its covariance) and single turning steps without a usable
-  sighting (MRPT's Gaussian odometry model at 0.0573 m per radian turned).
-  The pose-fix EKF (ekf-pose) is as accurate with a NEES slightly below the
-  band (the closed form's second-order C_R is conservative on these
-  renders). The particle filter's NEES is above the band: its cloud is
-  narrower than its error after resampling (overconfident by ~1.7x).
+  ATE <= 3 cm over the seeds, the runs' mean NEES averaged over the seeds
+  inside the 95% band of one run, first fix at the first frame;
+  tests/filters/test_sim.cpp checks the same on the same seeds. The largest
+  errors are the first fix (one landmark 4 m away, frontal, whose phi2 is
+  weakest there: 7-15 cm, inside its covariance) and single turning steps
+  without a usable sighting (MRPT's Gaussian odometry model at 0.0573 m per
+  radian turned). Since the closed form refines L on P
+  (`[pose] refine_on_primary`, docs/benchmarks/pose.md) the EKF's ATE is
+  2.4 cm (2.9 cm with the paper's formulas alone) and the particle filter's
+  NEES is at the band's lower edge (4.9 before). The pose-fix EKF
+  (ekf-pose) is as accurate with a NEES below the band (the second-order
+  C_R is conservative on these renders).
 - What phi2 adds (SLAM table): on the default renders the coded sightings
-  map the landmarks about 20% better than their BearingRange twin (same
+  map the landmarks about 40% better than their BearingRange twin (same
   filter, point landmarks) and than MRPT's kf-slam filter on that twin, and
-  give each landmark's yaw to about a degree; on the noisy renders the
+  give each landmark's yaw to under a degree; on the noisy renders the
   calibrated C_L is too optimistic for phi2 and the twin does better.
 - Noisier images (noise 6, blur 1.2 px): the detector's corners are worse
   than the calibrated sigma says, so the EKFs are overconfident (NEES far
