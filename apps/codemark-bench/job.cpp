@@ -54,7 +54,8 @@ std::optional<filters::PoseEstimate> initialPose(const mrpt::config::CConfigFile
 // Compares one frame's landmark observation with what the true pose shows.
 void tallyDetections(
 	const CObservationCodedLandmarks& obs, const CPose2D& truth, const LandmarkMap& map,
-	const std::optional<CameraModel>& camera_override, double min_span_px, DetectionStats& d)
+	const std::optional<CameraModel>& camera_override, double min_span_px,
+	double max_view_angle_deg, DetectionStats& d)
 {
 	sim::Scene scene;
 	scene.map = map;
@@ -64,7 +65,13 @@ void tallyDetections(
 	for (const auto& t : sim::groundTruth(scene))
 	{
 		if (sim::isInView(t, scene.camera)) visible.insert(t.id);
-		if (t.fully_visible && std::sqrt(t.area_px) >= min_span_px) in_view.insert(t.id);
+		// Seen beyond the stepper's max_view_angle_deg, a sighting is dropped
+		// before the filter (and before this tally): not expected.
+		const double view_angle_deg =
+			std::abs(mrpt::math::wrapToPi(t.sighting.L[1] + t.sighting.L[2])) * 180.0 / M_PI;
+		if (t.fully_visible && std::sqrt(t.area_px) >= min_span_px &&
+			view_angle_deg <= max_view_angle_deg)
+			in_view.insert(t.id);
 	}
 	std::set<int> right;
 	for (const auto& s : obs.sightings)
@@ -205,7 +212,9 @@ JobResult runJob(
 			if (row.truth && !mrpt_map)
 				for (const auto& o : step.observations)
 					if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
-						tallyDetections(*lm, *row.truth, map, camera, cfg.min_span_px, r.detection);
+						tallyDetections(
+							*lm, *row.truth, map, camera, cfg.min_span_px, so.max_view_angle_deg,
+							r.detection);
 			if (step.index == 0) first_t = step.timestamp;
 			if (row.estimate.initialized && s.first_fix_step < 0)
 			{
@@ -225,7 +234,10 @@ JobResult runJob(
 		s.detect_ms_per_image = r.detection.images ? 1000.0 * detect_s / r.detection.images : 0.0;
 		r.detection.detect_ms_per_image = s.detect_ms_per_image;
 		s.slam_map = filter->landmarks();
-		s.metrics = filters::computeMetrics(s.rows);
+		// SLAM without a prior map estimates in the frame of the robot's
+		// start: its ATE and NEES after the alignment (NEES anchored at the
+		// true first pose), as codemark-localize reports them.
+		s.metrics = filters::computeMetrics(s.rows, prior.landmarks.empty());
 		r.rpe = relativePoseError(s.rows, cfg.rpe_interval_s);
 		r.aligned = alignPath(s.rows);
 		filters::writeOutputs(s, map, out_dir);

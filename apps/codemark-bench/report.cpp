@@ -391,8 +391,9 @@ std::string markdownReport(
 		 "ground truth (fully "
 		 "visible, facing the camera, reference square spanning >= "
 	  << fmt(cfg.min_span_px, 0)
-	  << " px) and at least one of those was detected with its right ID, over the frames with one "
-		 "in view. "
+	  << " px, seen within the method ini's [stepper] max_view_angle_deg of its normal, beyond "
+		 "which sightings are dropped before the filter) and at least one of those was detected "
+		 "with its right ID, over the frames with one in view. "
 		 "**sighting rate**: the same per landmark and frame. **wrong IDs**: detections of an ID "
 		 "that no landmark "
 		 "in (even partial) view carries. Computed from the landmark observations of every camera "
