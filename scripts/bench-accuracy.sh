@@ -36,6 +36,8 @@ echo "== C_P calibration (the accuracy map's flat background, for comparison)"
 "$calib" --renders 3000 --seed 7
 echo "== accuracy map"
 "$map" --out apps/codemark-accuracy-map/results --renders 10
+echo "== accuracy map with the C_P calibrated on its own plain background (the NEES check)"
+"$map" --out apps/codemark-accuracy-map/results/plain-calibration --renders 10 --no-apriltag --calibration plain
 "$build_dir/apps/codemark-uncertainty/codemark-uncertainty" --out apps/codemark-uncertainty/results/fig3.png
 mkdir -p docs/images
 for f in heat_l2 heat_phi2 heat_x heat_y; do

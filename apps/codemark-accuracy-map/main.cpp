@@ -54,6 +54,12 @@ int main(int argc, char** argv)
 			"Fixed (--sigma-px) or Detector (the detector's per-detection corner sigma). Default "
 			"Fixed.",
 			false, "Fixed", "NAME", cmd);
+		TCLAP::ValueArg<std::string> calibration_arg(
+			"", "calibration",
+			"C_P model: realistic (the shipped detectorCalibratedPoseOptions, fitted on textured "
+			"walls) or plain (plainBackgroundPoseOptions, fitted on the plain background this map "
+			"renders by default). Default realistic.",
+			false, "realistic", "NAME", cmd);
 		TCLAP::SwitchArg paper_arg(
 			"", "paper-closed-form",
 			"The closed-form column uses the paper's formulas alone, without the weighted "
@@ -78,7 +84,17 @@ int main(int argc, char** argv)
 		o.max_distance_m = maxd_arg.getValue();
 		o.noise_sigma = noise_arg.getValue();
 		o.blur_sigma_px = blur_arg.getValue();
-		o.pose = codemark::pipeline::detectorCalibratedPoseOptions();
+		if (calibration_arg.getValue() == "plain")
+		{
+			o.pose = codemark::pipeline::plainBackgroundPoseOptions();
+			o.noise_label = "calibrated on a plain background (pipeline::plainBackgroundPoseOptions)";
+		}
+		else if (calibration_arg.getValue() == "realistic")
+			o.pose = codemark::pipeline::detectorCalibratedPoseOptions();
+		else
+			throw std::invalid_argument(
+				"--calibration: expected realistic or plain, got '" + calibration_arg.getValue() +
+				"'");
 		if (sigma_arg.isSet())
 		{
 			o.pose = codemark::pose::PoseOptions();
