@@ -87,7 +87,8 @@ int main(int argc, char** argv)
 		if (calibration_arg.getValue() == "plain")
 		{
 			o.pose = codemark::pipeline::plainBackgroundPoseOptions();
-			o.noise_label = "calibrated on a plain background (pipeline::plainBackgroundPoseOptions)";
+			o.noise_label =
+				"calibrated on a plain background (pipeline::plainBackgroundPoseOptions)";
 		}
 		else if (calibration_arg.getValue() == "realistic")
 			o.pose = codemark::pipeline::detectorCalibratedPoseOptions();

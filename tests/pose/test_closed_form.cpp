@@ -36,6 +36,22 @@ void expectJacobianNear(const A& analytic, const B& numeric, double rel, const s
 	}
 }
 
+// Central differences of \a f at \a x, step 1e-6 max(1, |x_k|).
+template <int Out, int In, typename F>
+Eigen::Matrix<double, Out, In> numericJacobian(const F& f, const Eigen::Matrix<double, In, 1>& x)
+{
+	Eigen::Matrix<double, Out, In> J;
+	for (int k = 0; k < In; ++k)
+	{
+		const double h = 1e-6 * std::max(1.0, std::abs(x[k]));
+		Eigen::Matrix<double, In, 1> a = x, b = x;
+		a[k] += h;
+		b[k] -= h;
+		J.col(k) = (f(a) - f(b)) / (2 * h);
+	}
+	return J;
+}
+
 struct Config
 {
 	double d, angle, z, phi1, scale;
@@ -107,17 +123,9 @@ TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
 			projectCorners(cameraAt(c.d, c.angle, c.z, c.phi1), cam, g), cam, &lambda);
 		Eigen::Matrix<double, 3, 4> J;
 		landmarkFromPrimary(P, lambda, g.innerHalf(), &J);
-		Eigen::Matrix<double, 3, 4> Jn;
-		for (int k = 0; k < 4; ++k)
-		{
-			const double h = 1e-6 * std::max(1.0, std::abs(P[k]));
-			Eigen::Vector4d a = P, b = P;
-			a[k] += h;
-			b[k] -= h;
-			Jn.col(k) = (landmarkFromPrimary(a, lambda, g.innerHalf()) -
-						 landmarkFromPrimary(b, lambda, g.innerHalf())) /
-						(2 * h);
-		}
+		const auto Jn = numericJacobian<3, 4>(
+			[&](const Eigen::Vector4d& p) { return landmarkFromPrimary(p, lambda, g.innerHalf()); },
+			P);
 		expectJacobianNear(J, Jn, 1e-6, "J_P");
 	}
 }
@@ -136,17 +144,9 @@ TEST(ClosedForm, PrimaryFromLandmarkInvertsTheClosedForm)
 		const Eigen::Vector4d back = primaryFromLandmark(L, lambda, g.innerHalf(), &J);
 		EXPECT_LT((back - P).cwiseAbs().maxCoeff(), 1e-9 * P.cwiseAbs().maxCoeff())
 			<< "d " << c.d << " angle " << c.angle;
-		Eigen::Matrix<double, 4, 3> Jn;
-		for (int k = 0; k < 3; ++k)
-		{
-			const double h = 1e-6 * std::max(1.0, std::abs(L[k]));
-			Eigen::Vector3d a = L, b = L;
-			a[k] += h;
-			b[k] -= h;
-			Jn.col(k) = (primaryFromLandmark(a, lambda, g.innerHalf()) -
-						 primaryFromLandmark(b, lambda, g.innerHalf())) /
-						(2 * h);
-		}
+		const auto Jn = numericJacobian<4, 3>(
+			[&](const Eigen::Vector3d& l) { return primaryFromLandmark(l, lambda, g.innerHalf()); },
+			L);
 		expectJacobianNear(J, Jn, 1e-6, "dP/dL");
 	}
 	EXPECT_THROW(

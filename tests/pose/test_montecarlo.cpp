@@ -59,6 +59,27 @@ double relFrobenius(const Eigen::Matrix3d& emp, const Eigen::Matrix3d& pred)
 {
 	return (emp - pred).norm() / pred.norm();
 }
+
+// N samples of P = m0.P + sigma N(0, I) through \a estimate (P -> L): the
+// statistics of the deviations of L and of the pose from the noise-free m0.
+template <typename F>
+std::pair<Stats, Stats> sampleDeviations(
+	const Measurement& m0, double sigma, int N, std::mt19937& rng,
+	std::normal_distribution<double>& n01, const F& estimate)
+{
+	std::vector<Eigen::Vector3d> dL, dR;
+	for (int i = 0; i < N; ++i)
+	{
+		Eigen::Vector4d P = m0.P;
+		for (int k = 0; k < 4; ++k) P[k] += sigma * n01(rng);
+		const Eigen::Vector3d L = estimate(P);
+		Eigen::Vector3d a = L - m0.L, b = poseFromLandmark(L) - m0.pose_in_landmark;
+		b[2] = wrapToPi(b[2]);
+		dL.push_back(a);
+		dR.push_back(b);
+	}
+	return {stats(dL), stats(dR)};
+}
 }  // namespace
 
 TEST(MonteCarlo, FirstOrderCovarianceAndMeanOnTheGrid)
@@ -86,19 +107,10 @@ TEST(MonteCarlo, FirstOrderCovarianceAndMeanOnTheGrid)
 			if (std::sqrt(m0.C_L(2, 2)) * 180 / M_PI >= 5.0) continue;
 			if (2 * std::min(m0.P[1], m0.P[3]) < 30.0) continue;
 			++cells;
-			std::vector<Eigen::Vector3d> dL, dR;
-			for (int i = 0; i < N; ++i)
-			{
-				Eigen::Vector4d P = m0.P;
-				for (int k = 0; k < 4; ++k) P[k] += sigma * n01(rng);
-				const Eigen::Vector3d L = landmarkFromPrimary(P, cam.fx(), g.innerHalf());
-				const Eigen::Vector3d R = poseFromLandmark(L);
-				Eigen::Vector3d a = L - m0.L, b = R - m0.pose_in_landmark;
-				b[2] = wrapToPi(b[2]);
-				dL.push_back(a);
-				dR.push_back(b);
-			}
-			const Stats sL = stats(dL), sR = stats(dR);
+			const auto [sL, sR] = sampleDeviations(
+				m0, sigma, N, rng, n01,
+				[&](const Eigen::Vector4d& P)
+				{ return landmarkFromPrimary(P, cam.fx(), g.innerHalf()); });
 			const double eL = relFrobenius(sL.cov, m0.C_L), eR = relFrobenius(sR.cov, m0.C_R);
 			EXPECT_LT(eL, 0.10) << "C_L at d " << d << " angle " << deg;
 			EXPECT_LT(eR, 0.10) << "C_R at d " << d << " angle " << deg;
@@ -171,20 +183,14 @@ TEST(MonteCarlo, RefinedClosedFormCovarianceOnTheGrid)
 			if (std::sqrt(m0.C_L(2, 2)) * 180 / M_PI >= 2.0) continue;
 			if (2 * std::min(m0.P[1], m0.P[3]) < 30.0) continue;
 			++cells;
-			std::vector<Eigen::Vector3d> dL, dR;
-			for (int i = 0; i < N; ++i)
-			{
-				Eigen::Vector4d P = m0.P;
-				for (int k = 0; k < 4; ++k) P[k] += sigma * n01(rng);
-				const Eigen::Vector3d L = refineLandmarkOnPrimary(
-					P, m0.C_P, cam.fx(), g.innerHalf(),
-					landmarkFromPrimary(P, cam.fx(), g.innerHalf()));
-				Eigen::Vector3d a = L - m0.L, b = poseFromLandmark(L) - m0.pose_in_landmark;
-				b[2] = wrapToPi(b[2]);
-				dL.push_back(a);
-				dR.push_back(b);
-			}
-			const Stats sL = stats(dL), sR = stats(dR);
+			const auto [sL, sR] = sampleDeviations(
+				m0, sigma, N, rng, n01,
+				[&](const Eigen::Vector4d& P)
+				{
+					return refineLandmarkOnPrimary(
+						P, m0.C_P, cam.fx(), g.innerHalf(),
+						landmarkFromPrimary(P, cam.fx(), g.innerHalf()));
+				});
 			const double eL = relFrobenius(sL.cov, m0.C_L), eR = relFrobenius(sR.cov, m0.C_R);
 			EXPECT_LT(eL, 0.10) << "C_L at d " << d << " angle " << deg;
 			EXPECT_LT(eR, 0.10) << "C_R at d " << d << " angle " << deg;
