@@ -242,7 +242,8 @@ std::vector<CellResult> runSurvey(
 	lm.z_m = 0.5;
 	scene.map.landmarks.push_back(lm);
 	scene.camera = camera;
-	sim::RenderOptions ro = o.realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
+	sim::RenderOptions ro =
+		o.realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
 	ro.noise_sigma = o.noise_sigma;
 	ro.blur_sigma_px = o.blur_sigma_px;
 	const LandmarkGeometry g = lm.geometry();
