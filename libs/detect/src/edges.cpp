@@ -33,8 +33,9 @@ EdgelMap findEdgels(
 	cv::Mat g, gx, gy;
 	cv::extractChannel(bgr(m.roi), g, 1);
 	if (k > 1) cv::resize(g, g, cv::Size(m.roi.width / k, m.roi.height / k), 0, 0, cv::INTER_AREA);
-	cv::Sobel(g, gx, CV_16S, 1, 0, 3, 1, 0, cv::BORDER_REPLICATE);
-	cv::Sobel(g, gy, CV_16S, 0, 1, 3, 1, 0, cv::BORDER_REPLICATE);
+	// Both 3x3 Sobel derivatives in one pass (the same values as two
+	// cv::Sobel calls, about half their time).
+	cv::spatialGradient(g, gx, gy, 3, cv::BORDER_REPLICATE);
 	// The 3x3 Sobel answers 8 per grey level per pixel of slope.
 	const int t = static_cast<int>(std::ceil(8 * threshold));
 	const int t2 = t * t;
