@@ -4,6 +4,7 @@
 #include <codemark/filters/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/stepper.h>
+#include <codemark/pose/closed_form.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <codemark/sim/frames.h>
@@ -67,10 +68,8 @@ void tallyDetections(
 		if (sim::isInView(t, scene.camera)) visible.insert(t.id);
 		// Seen beyond the stepper's max_view_angle_deg, a sighting is dropped
 		// before the filter (and before this tally): not expected.
-		const double view_angle_deg =
-			std::abs(mrpt::math::wrapToPi(t.sighting.L[1] + t.sighting.L[2])) * 180.0 / M_PI;
 		if (t.fully_visible && std::sqrt(t.area_px) >= min_span_px &&
-			view_angle_deg <= max_view_angle_deg)
+			pose::viewAngle(t.sighting.L) <= max_view_angle_deg * M_PI / 180.0)
 			in_view.insert(t.id);
 	}
 	std::set<int> right;

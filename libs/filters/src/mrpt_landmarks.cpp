@@ -1,5 +1,6 @@
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/landmark/text.h>
+#include <mrpt/slam/CRangeBearingKFSLAM2D.h>
 
 #include <cmath>
 #include <fstream>

@@ -1,6 +1,7 @@
 // The rawlog stepper: both formats, streaming, one step per camera frame,
 // odometry interpolated to the frame's time in the observations-only format.
 #include <codemark/filters/stepper.h>
+#include <codemark/pose/closed_form.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
@@ -429,7 +430,7 @@ struct RawlogStepper::Impl
 		if (opt.max_view_angle_deg >= 90.0) return;
 		const double max_rad = opt.max_view_angle_deg * M_PI / 180.0;
 		auto oblique = [&](const CObservationCodedLandmarks::TSighting& t)
-		{ return std::abs(mrpt::math::wrapToPi(t.L[1] + t.L[2])) > max_rad; };
+		{ return pose::viewAngle(t.L) > max_rad; };
 		mrpt::obs::CSensoryFrame out;
 		bool changed = false;
 		for (const auto& o : s.observations)

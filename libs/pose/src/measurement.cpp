@@ -170,10 +170,12 @@ Measurement measure(
 	{
 		Eigen::Matrix<double, 3, 4> J_P;
 		Eigen::Matrix3d J_L;
-		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), &J_P);
-		m.C_L = J_P * m.C_P * J_P.transpose();
-		if (options.refine_on_primary)
+		const bool refine = options.refine_on_primary;
+		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), refine ? nullptr : &J_P);
+		if (refine)
 			m.L = refineLandmarkOnPrimary(m.P, m.C_P, lambda, geometry.innerHalf(), m.L, &m.C_L);
+		else
+			m.C_L = J_P * m.C_P * J_P.transpose();
 		m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
 		m.C_R = options.second_order_pose_covariance
 					? poseCovarianceSecondOrder(m.L, m.C_L)

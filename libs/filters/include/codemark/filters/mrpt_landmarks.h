@@ -10,13 +10,17 @@
  * and blank lines are comments.
  */
 #include <codemark/landmark/map.h>
-#include <mrpt/slam/CRangeBearingKFSLAM2D.h>
 
 #include <Eigen/Core>
 #include <map>
 
 #include <iosfwd>
 #include <string>
+
+namespace mrpt::slam
+{
+class CRangeBearingKFSLAM2D;
+}
 
 namespace codemark::filters
 {

@@ -11,6 +11,7 @@
 #include <mrpt/poses/CPose3D.h>
 
 #include <Eigen/Core>
+#include <cmath>
 
 namespace codemark::pose
 {
@@ -56,6 +57,14 @@ Eigen::Vector4d primaryFromLandmark(
 Eigen::Vector3d refineLandmarkOnPrimary(
 	const Eigen::Vector4d& P, const Eigen::Matrix4d& C_P, double lambda_px, double h_m,
 	const Eigen::Vector3d& L0, Eigen::Matrix3d* C_L = nullptr);
+
+/** The viewing angle of a sighting L [rad]: between the line of sight and
+ * the landmark's outward normal, |phi1 + phi2| wrapped to [0, pi] (0 seen
+ * squarely). */
+inline double viewAngle(const Eigen::Vector3d& L)
+{
+	return std::abs(std::remainder(L[1] + L[2], 2 * M_PI));
+}
 
 /** The camera's planar pose in frame L from L (paper eq. 12-14 in the spec's
  * convention): x = l2 cos(phi1 + phi2), y = l2 sin(phi1 + phi2),
