@@ -1,6 +1,8 @@
 // The rawlog stepper on small synthetic rawlogs of both formats.
 #include <codemark/filters/stepper.h>
 #include <gtest/gtest.h>
+#include <codemark/landmark/camera.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -243,6 +245,40 @@ TEST(Stepper, AnnotatedImagesAreNotDetectedAgainButBareOnesAre)
 	{
 		EXPECT_NE(std::string(e.what()).find("entry #1"), std::string::npos) << e.what();
 	}
+}
+
+// Each stepper loads its own rawlog's external images, also while another
+// stepper reads another rawlog (codemark-bench runs datasets in parallel):
+// MRPT's images folder is process-wide, and the second stepper's rawlog
+// used to redirect the first one's relative file names to its own folder.
+TEST(Stepper, ExternalImagesComeFromTheirOwnRawlogsFolder)
+{
+	const auto dir = std::filesystem::path(tempFile("two_rawlogs"));
+	std::filesystem::create_directories(dir / "with_Images");
+	std::filesystem::create_directories(dir / "without_Images");
+	const CameraModel cam = CameraModel::paperDefault();
+	mrpt::img::CImage grey(cam.width(), cam.height(), mrpt::img::CH_RGB);
+	grey.filledRectangle(0, 0, cam.width() - 1, cam.height() - 1, mrpt::img::TColor(128, 128, 128));
+	ASSERT_TRUE(grey.saveToFile((dir / "with_Images" / "frame.png").string()));
+	const auto image = [&]
+	{
+		auto img = mrpt::obs::CObservationImage::Create();
+		img->sensorLabel = "CAM";
+		img->timestamp = mrpt::Clock::fromDouble(kT0);
+		img->cameraParams = cam.params();
+		img->image.setExternalStorage("frame.png");
+		return img;
+	};
+	const std::string with = (dir / "with.rawlog").string(),
+					  without = (dir / "without.rawlog").string();
+	writeRawlog(with, {odoAt(0), image()});
+	writeRawlog(without, {odoAt(0), image()});
+	RawlogStepper a(with);
+	RawlogStepper b(without);  // opened after a: its folder holds no frame.png
+	RawlogStep s;
+	ASSERT_TRUE(a.next(s));
+	EXPECT_EQ(s.images_detected, 1);
+	EXPECT_THROW(b.next(s), std::runtime_error);
 }
 
 TEST(Stepper, CorruptEntryNamesItsIndexAndNoTimestampsGiveStepIndices)

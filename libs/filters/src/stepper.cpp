@@ -3,7 +3,6 @@
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
-#include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/math/wrap2pi.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -465,7 +464,9 @@ RawlogStepper::RawlogStepper(
 	if (!impl_->in.open(path)) throw std::runtime_error(path + ": cannot open");
 	impl_->total_bytes = static_cast<long>(impl_->in.getTotalBytesCount());
 	if (impl_->total_bytes == 0) throw std::runtime_error(path + ": empty file, not a rawlog");
-	mrpt::img::CImage::setImagesPathBase(pipeline::imagesDirectoryOf(path));
+	// This rawlog's external images, not MRPT's process-wide folder (other
+	// steppers may read other rawlogs at the same time).
+	impl_->pipe.images_dir = pipeline::imagesDirectoryOf(path);
 }
 
 RawlogStepper::~RawlogStepper() = default;

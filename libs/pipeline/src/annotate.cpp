@@ -1,5 +1,4 @@
 #include <codemark/pipeline/annotate.h>
-#include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -48,7 +47,7 @@ void linkImagesFolder(const std::string& in_path, const std::string& out_path)
 			"cannot link " + out_dir.string() + " to " + in_dir.string() + ": " + ec.message());
 }
 
-void runJobs(std::vector<Job>& jobs, const AnnotateOptions& o, int threads)
+void runJobs(std::vector<Job>& jobs, const PipelineOptions& pipe, int threads)
 {
 	std::atomic<std::size_t> next{0};
 	auto work = [&]
@@ -59,7 +58,7 @@ void runJobs(std::vector<Job>& jobs, const AnnotateOptions& o, int threads)
 			try
 			{
 				ImageResult r;
-				j.result = observeImage(*j.image, o.pipeline, &r);
+				j.result = observeImage(*j.image, pipe, &r);
 				j.detect_us = r.timings.total_us;
 			}
 			catch (const std::exception& e)
@@ -89,7 +88,9 @@ AnnotateSummary annotateRawlog(
 	mrpt::io::CFileGZOutputStream out;
 	if (!out.open(out_path)) throw std::runtime_error(out_path + ": cannot write");
 	linkImagesFolder(in_path, out_path);
-	mrpt::img::CImage::setImagesPathBase(imagesDirectoryOf(in_path));
+	// This rawlog's external images, not MRPT's process-wide folder.
+	PipelineOptions pipe = o.pipeline;
+	pipe.images_dir = imagesDirectoryOf(in_path);
 
 	auto ar_in = mrpt::serialization::archiveFrom(in);
 	auto ar_out = mrpt::serialization::archiveFrom(out);
@@ -152,7 +153,7 @@ AnnotateSummary annotateRawlog(
 			else if (auto img = std::dynamic_pointer_cast<CObservationImage>(entries[e]))
 				jobs.push_back({e, img.get(), nullptr, 0, {}});
 		}
-		runJobs(jobs, o, threads);
+		runJobs(jobs, pipe, threads);
 		for (const auto& j : jobs)
 		{
 			if (!j.error.empty())

@@ -44,28 +44,31 @@ ImageResult processImage(
 	return r;
 }
 
-cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img)
+cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img, const std::string& images_dir)
 {
 	cv::Mat m;
+	std::string file = "embedded image";
 	try
 	{
-		if (img.image.isExternallyStored()) img.image.forceLoad();
-		m = img.image.asCvMatRef();
+		if (!img.image.isExternallyStored())
+			m = img.image.asCvMatRef();
+		else
+		{
+			// Resolved here rather than through MRPT's process-wide images
+			// folder, which parallel readers of different rawlogs share.
+			const std::string name = img.image.getExternalStorageFile();
+			file = images_dir.empty() || (!name.empty() && name.front() == '/')
+					   ? img.image.getExternalStorageFileAbsolutePath()
+					   : images_dir + "/" + name;
+			mrpt::img::CImage loaded;
+			if (loaded.loadFromFile(file)) m = loaded.asCvMatRef();
+		}
 	}
 	catch (const std::exception& e)
 	{
-		const std::string f = img.image.isExternallyStored()
-								  ? img.image.getExternalStorageFileAbsolutePath()
-								  : std::string("embedded image");
-		throw std::runtime_error("cannot load image '" + f + "': " + e.what());
+		throw std::runtime_error("cannot load image '" + file + "': " + e.what());
 	}
-	if (m.empty())
-	{
-		const std::string f = img.image.isExternallyStored()
-								  ? img.image.getExternalStorageFileAbsolutePath()
-								  : std::string("embedded image");
-		throw std::runtime_error("cannot load image '" + f + "' (missing or empty)");
-	}
+	if (m.empty()) throw std::runtime_error("cannot load image '" + file + "' (missing or empty)");
 	cv::Mat bgr;
 	if (m.depth() != CV_8U) throw std::runtime_error("image is not 8-bit per channel");
 	if (m.channels() == 1)
@@ -82,14 +85,13 @@ CObservationCodedLandmarks::Ptr observeImage(
 {
 	const CameraModel camera =
 		o.camera_override ? *o.camera_override : CameraModel(img.cameraParams);
-	const cv::Mat bgr = imageAsBgr(img);
+	const cv::Mat bgr = imageAsBgr(img, o.images_dir);
 	if (bgr.cols != camera.width() || bgr.rows != camera.height())
 		throw std::runtime_error(
 			"image is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
 			" but the camera is " + std::to_string(camera.width()) + "x" +
 			std::to_string(camera.height()));
 	ImageResult r = processImage(bgr, camera, o);
-	if (img.image.isExternallyStored()) img.image.unload();
 
 	auto obs = CObservationCodedLandmarks::Create();
 	obs->sensorLabel = img.sensorLabel + "_LANDMARKS";

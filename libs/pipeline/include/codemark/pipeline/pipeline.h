@@ -123,6 +123,11 @@ struct PipelineOptions
 	std::optional<LandmarkMap> map;
 	/** When set, replaces the camera stored in each image observation. */
 	std::optional<CameraModel> camera_override;
+	/** Folder of externally stored images with relative file names (a
+	 * rawlog's `<name>_Images`, imagesDirectoryOf()). Empty: MRPT's
+	 * process-wide CImage::getImagesPathBase(), which two rawlogs read in
+	 * parallel (codemark-bench's jobs) would share. */
+	std::string images_dir;
 };
 
 /** One measured landmark: the detection and its measurement. */
@@ -156,10 +161,12 @@ CObservationCodedLandmarks::Ptr observeImage(
 	const mrpt::obs::CObservationImage& img, const PipelineOptions& o,
 	ImageResult* result_out = nullptr);
 
-/** The BGR cv::Mat of an image observation (loading external storage);
- * grey images are converted. Throws std::runtime_error naming the file when
+/** The BGR cv::Mat of an image observation (loading external storage, a
+ * relative file name from \a images_dir, or MRPT's
+ * CImage::getImagesPathBase() when it is empty); grey images are
+ * converted. Throws std::runtime_error naming the file when
  * it cannot be loaded. */
-cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img);
+cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img, const std::string& images_dir = {});
 
 /** `<dir>/<name without extension>_Images` for a rawlog path: MRPT's
  * external-image folder. Computed here because MRPT 2.5.8's
