@@ -15,6 +15,7 @@
 #include <codemark/landmark/truth.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/sim/render.h>
+#include <mrpt/config/CConfigFile.h>
 #include <tclap/CmdLine.h>
 
 #include <cmath>
@@ -64,6 +65,14 @@ int main(int argc, char** argv)
 			"wall, light gradient, noise 2, blur 0.8) instead of the accuracy map's flat "
 			"background.",
 			cmd, false);
+		TCLAP::ValueArg<std::string> render_arg(
+			"", "render-config",
+			"Ini file whose [render] section overrides the render options (after --realistic), "
+			"e.g. gradient, background, noise_sigma, blur_sigma_px.",
+			false, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> detector_arg(
+			"", "detector-config", "Detector options ini (share/codemark/detector.ini's format).",
+			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> csv_arg(
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
 		cmd.setExceptionHandling(false);
@@ -79,8 +88,15 @@ int main(int argc, char** argv)
 		ro.noise_sigma = 2;
 		ro.blur_sigma_px = 0.8;
 		if (realistic_arg.getValue()) ro = sim::DatasetOptions::realisticRender();
+		if (!render_arg.getValue().empty())
+		{
+			const mrpt::config::CConfigFile ini(render_arg.getValue());
+			ro.loadFromConfigFile(ini, "render");
+		}
 		const LandmarkGeometry g = lm.geometry();
-		const detect::DetectorOptions dopt;
+		const detect::DetectorOptions dopt = detector_arg.getValue().empty()
+												 ? detect::DetectorOptions()
+												 : detect::DetectorOptions::load(detector_arg.getValue());
 		std::mt19937_64 rng(seed_arg.getValue());
 		std::uniform_real_distribution<double> U(0, 1);
 		std::vector<Sample> samples;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <sstream>
 
 using namespace codemark;
@@ -88,6 +89,52 @@ TEST(Renders, IlluminationGainWithGradient)
 				++n;
 			}
 	EXPECT_EQ(n, 32);
+}
+
+// A fill brighter than the sensor's top clips G on the bright half of the
+// inner edge's response: read as it is, the edge moves outwards and the
+// square looks larger (a range error). The edge model fitted with the clip
+// (SubpixelParams::model_clipping) must remove most of it, at gains from a
+// fill exactly at the top (only the noise clips) to 1.6, near and far.
+TEST(Renders, ClippedFillDoesNotInflateTheSquare)
+{
+	for (const double gain : {1.0, 1.1, 1.3, 1.6})
+		for (const double dist : {1.0, 2.0, 3.5})
+		{
+			double grow[2] = {0, 0};
+			int n = 0;
+			for (const double angle : {0.0, 25.0})
+				for (int k = 0; k < 3; ++k, ++n)
+				{
+					auto o = nominalRender();
+					o.gain = gain;
+					const Shot s =
+						shoot((n * 41 + 3) % 256, dist, angle * kDeg, o, 900 + n, 0.04 * (k - 1));
+					const auto& t = s.render.truth[0];
+					ASSERT_TRUE(t.fully_visible);
+					for (const bool clipping : {false, true})
+					{
+						DetectorOptions opt;
+						opt.subpixel.model_clipping = clipping;
+						const auto r =
+							detect::detect(s.render.image, CameraModel(), LandmarkGeometry(), opt);
+						ASSERT_EQ(r.landmarks.size(), 1u);
+						const Eigen::Vector4d e = r.landmarks[0].P - t.P;
+						// Half the growth of width and height: each edge's outward shift.
+						grow[clipping] += 0.25 * (e[2] - e[0] + e[1] + e[3]);
+					}
+				}
+			const double without = grow[0] / n, with = grow[1] / n;
+			std::ostringstream what;
+			what << "gain " << gain << " at " << dist << " m: each edge " << without
+				 << " px outwards without the model, " << with << " px with it";
+			std::printf("[ clip ] %s\n", what.str().c_str());
+			SCOPED_TRACE(what.str());
+			// Within 2 m the frame is 9 px or wider; at 3.5 m 4-5 px, where
+			// the frame's outer edge and the margin enter the model.
+			EXPECT_LT(std::abs(with), dist <= 2 ? 0.02 : 0.12);
+			if (gain > 1) EXPECT_LT(std::abs(with), 0.4 * std::abs(without));
+		}
 }
 
 TEST(Renders, NoiseUpTo5)

@@ -81,7 +81,10 @@ DetectionResult detect(
 		// 7. Sub-pixel edges, a line per side, corners.
 		const double frame_ratio =
 			(geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
-		auto refined = refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel);
+		const double fill_ratio =
+			(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m);
+		auto refined =
+			refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio);
 		tm.subpixel_us += microsSince(t);
 		if (!refined) continue;
 		++res.counts.fitted;

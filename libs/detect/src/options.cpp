@@ -74,6 +74,8 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.saturation_level", o.subpixel.saturation_level);
 	f("subpixel.min_frame_px_centroid", o.subpixel.min_frame_px_centroid);
 	f("subpixel.model_outer_edge", o.subpixel.model_outer_edge);
+	f("subpixel.model_clipping", o.subpixel.model_clipping);
+	f("subpixel.clipped_fraction", o.subpixel.clipped_fraction);
 	f("subpixel.min_rise_rb", o.subpixel.min_rise_rb);
 	f("subpixel.outlier_sigmas", o.subpixel.outlier_sigmas);
 	f("subpixel.min_outlier_px", o.subpixel.min_outlier_px);
@@ -133,6 +135,9 @@ void DetectorOptions::validate() const
 		"in 1..256 (256: never)");
 	require(p.min_frame_px_centroid >= 0, "subpixel.min_frame_px_centroid", ">= 0");
 	require(p.min_rise_rb > 0, "subpixel.min_rise_rb", "> 0");
+	require(
+		p.clipped_fraction >= 0 && p.clipped_fraction <= 1, "subpixel.clipped_fraction",
+		"in [0, 1]");
 	require(p.response_floor >= 0 && p.response_floor < 1, "subpixel.response_floor", "in [0, 1)");
 	require(
 		p.outlier_sigmas > 0 && p.min_outlier_px > 0, "subpixel.outlier_sigmas/min_outlier_px",

@@ -152,6 +152,50 @@ std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
 	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
 
+/** The profiles of one side, for imputeClippedSide(). Sample i of profile
+ * j lies at across coordinate base[j] + inward * i (i grows into the fill)
+ * and along coordinate along[j]. */
+struct ClippedSideProfiles
+{
+	int n = 0;	//!< samples per profile
+	int inward = 1;	 //!< +1 or -1
+	std::vector<uint8_t> bgr;  //!< profile j, sample i, channel c at (j n + i) 3 + c
+	std::vector<double> along;	//!< per profile [px]
+	std::vector<double> base;  //!< per profile [px]
+};
+
+/** Restores the G profiles of a side whose green fill clips at the
+ * sensor's top, so that the usual edge estimators can read them: a blurred
+ * step in each of B, G and R, with the side's blur and levels and a
+ * quadratic edge along it, is fitted by maximum likelihood with the samples
+ * at 255 (or 0) censored (they say only "at least 254.5"); each clipped G
+ * sample on the fill side of its profile's edge is then replaced by its
+ * expectation under that model and the clip. The clip cuts the bright half
+ * of the edge's response, which moves the derivative's peak and centroid
+ * outwards, by 0.05-0.4 px at gains of 1.05-1.6 (the square looks larger);
+ * the model is only used for the clipped samples, so its own shape error
+ * (0.01-0.03 px) matters little where few are clipped. \a initial: each
+ * profile's edge estimate [profile index] (nullopt: none); \a frame_px,
+ * \a fill_px: the black frame's and the green band's widths across the side
+ * [px] (the fitted samples stay clear of their other edges); \a noise: the
+ * sensor's noise in G [grey levels] (centreCellNoise()); \a clipped_fraction:
+ * the fraction of the fill-side samples at 255; \a g_profiles:
+ * side.along.size() x side.n G samples, modified in place. Returns false,
+ * leaving them as they were, when the side has too few edge points, the
+ * fit does not converge near them, or the edge is too sharp (one mixed
+ * sample per profile) for the model to say where a clipped edge lies. */
+bool imputeClippedSide(
+	const ClippedSideProfiles& side, const std::vector<std::optional<double>>& initial,
+	double frame_px, double fill_px, double noise, double clipped_fraction,
+	std::vector<int>& g_profiles);
+
+/** The noise of G [grey levels] in the always-black centre code cell of the
+ * quadrangle \a coarse (around its diagonals' intersection, the projected
+ * centre), \a cell_rel the cell's side over the reference square's: robust
+ * spread of neighbouring pixels' differences. 0 when the cell is under
+ * 3 x 3 px in the image. */
+double centreCellNoise(const cv::Mat& bgr, const Quad& coarse, double cell_rel);
+
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit
 {
@@ -178,10 +222,12 @@ struct RefinedQuad
  * sub-pixel edge points undistorted, a line per side, corners from
  * neighbouring intersections distorted back to raw pixels. \a min_rise is
  * the smallest G slope of an edge [grey levels / px]; \a frame_ratio the
- * black frame's width over the inner side (0.125 for the spec's landmark). */
+ * black frame's width over the inner side (0.125 for the spec's landmark),
+ * \a fill_ratio the green band's between the inner edge and the code board
+ * (35 / 160). */
 std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& camera, double min_rise,
-	double frame_ratio, const SubpixelParams& p);
+	double frame_ratio, const SubpixelParams& p, double fill_ratio = 35.0 / 160);
 
 // ------------------------------------------------------------------ stage 8
 /** The code of one landmark. */

@@ -197,13 +197,14 @@ std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelP
 
 std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& cam, double min_rise,
-	double frame_ratio, const SubpixelParams& p)
+	double frame_ratio, const SubpixelParams& p, double fill_ratio)
 {
 	RefinedQuad out;
 	const bool distorted = cam.hasDistortion();
 	const Eigen::Vector2d centre = 0.25 * (coarse[0] + coarse[1] + coarse[2] + coarse[3]);
 	const int W = bgr.cols, H = bgr.rows;
 	const int half = p.search_px + p.reach_px + 2;
+	double noise = -1;	// the centre cell's, when a side clips
 	for (int side = 0; side < 4; ++side)
 	{
 		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
@@ -240,7 +241,10 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int n = 2 * half + 1;
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
-		int saturated = 0, clipped = 0;
+		ClippedSideProfiles clip_side;
+		clip_side.n = n;
+		clip_side.inward = inward;
+		int saturated = 0, clipped = 0, fill_clipped = 0, fill_samples = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
 			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
@@ -257,7 +261,14 @@ std::optional<RefinedQuad> refineQuadrangle(
 					along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
 				g_prof.push_back(px[1]);
 				rb_prof.push_back(-(px[0] + px[2]));
-				if (i >= hi + 2) fill_sum += px[1];
+				clip_side.bgr.insert(clip_side.bgr.end(), px, px + 3);
+				if (i >= hi + 2)
+				{
+					fill_sum += px[1];
+					// Of the fill's samples (not a code cell's).
+					fill_clipped += px[1] >= 255;
+					fill_samples += px[1] >= 128;
+				}
 			}
 			if (fill_sum >= p.saturation_level * (n - hi - 2))
 			{
@@ -272,6 +283,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 			}
 			pos.push_back(s);
 			origin.push_back(c0);
+			clip_side.along.push_back(s);
+			clip_side.base.push_back(c0 - inward * half);
 		}
 		// G saturates on bright fills (the sensor clips at 255), which cuts
 		// the response on the bright side and pulls its centroid towards the
@@ -289,46 +302,69 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int half_count = static_cast<int>(pos.size()) / 2;
 		const bool side_saturated = saturated > half_count;
 		const bool side_clipped = clipped > half_count;
+		const auto locateAll = [&](bool saturated_path)
+		{
+			std::vector<std::optional<double>> edges(pos.size());
+			for (size_t j = 0; j < pos.size(); ++j)
+			{
+				const int* gp = g_prof.data() + j * n;
+				const int* rbp = rb_prof.data() + j * n;
+				// The edge must have the green fill just inside it (G above
+				// R + B two pixels inwards): the sheet's edge against a
+				// darker wall rises inwards too, a frame width and a margin
+				// outside.
+				const auto greenInside = [&](double e)
+				{
+					const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
+					return gp[i] > -rbp[i];
+				};
+				const auto locate = [&](int l, int h) -> std::optional<double>
+				{
+					if (!saturated_path)
+						return locateRisingEdge(
+							gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
+					// In R + B the frame's outer edge (white to black) rises
+					// too, a frame width away: search only next to the G
+					// peak and stop the response where it stops falling.
+					const auto g_peak = locateRisingEdge(
+						gp, n, l, h, min_rise, p, EdgeMode::Peak,
+						p.model_outer_edge && !side_clipped ? frame_px : 0.0);
+					if (!g_peak) return std::nullopt;
+					std::optional<double> r;
+					const int k = static_cast<int>(std::lround(*g_peak));
+					if (side_clipped && mode == EdgeMode::Centroid)
+						r = locateRisingEdge(
+							rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
+					return r ? r : g_peak;
+				};
+				std::optional<double> e = locate(lo, hi);
+				if (e && !greenInside(*e))
+				{
+					// Retry inwards of the rejected edge.
+					e = locate(static_cast<int>(std::lround(*e)) + 1, hi);
+					if (e && !greenInside(*e)) e.reset();
+				}
+				edges[j] = e;
+			}
+			return edges;
+		};
+		std::vector<std::optional<double>> edges = locateAll(side_saturated);
+		// Where G clips (on the fill side of the search window, noise on a
+		// fill at the sensor's top included), restore the clipped samples
+		// from a model of the edge that knows the clip and read the edges
+		// again as on an unsaturated side.
+		const bool clips = p.model_clipping && fill_samples > 0 &&
+						   fill_clipped > p.clipped_fraction * fill_samples;
+		if (clips && noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+		if (clips && imputeClippedSide(
+						 clip_side, edges, frame_px, frame_px * fill_ratio / frame_ratio, noise,
+						 double(fill_clipped) / fill_samples, g_prof))
+			edges = locateAll(false);
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)
 		{
-			const int* gp = g_prof.data() + j * n;
-			const int* rbp = rb_prof.data() + j * n;
-			// The edge must have the green fill just inside it (G above R + B
-			// two pixels inwards): the sheet's edge against a darker wall
-			// rises inwards too, a frame width and a margin outside.
-			const auto greenInside = [&](double e)
-			{
-				const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
-				return gp[i] > -rbp[i];
-			};
-			const auto locate = [&](int l, int h) -> std::optional<double>
-			{
-				if (!side_saturated)
-					return locateRisingEdge(
-						gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
-				// In R + B the frame's outer edge (white to black) rises too,
-				// a frame width away: search only next to the G peak and stop
-				// the response where it stops falling.
-				const auto g_peak = locateRisingEdge(
-					gp, n, l, h, min_rise, p, EdgeMode::Peak,
-					p.model_outer_edge && !side_clipped ? frame_px : 0.0);
-				if (!g_peak) return std::nullopt;
-				std::optional<double> r;
-				const int k = static_cast<int>(std::lround(*g_peak));
-				if (side_clipped && mode == EdgeMode::Centroid)
-					r = locateRisingEdge(
-						rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
-				return r ? r : g_peak;
-			};
-			std::optional<double> e = locate(lo, hi);
-			if (e && !greenInside(*e))
-			{
-				// Retry inwards of the rejected edge.
-				e = locate(static_cast<int>(std::lround(*e)) + 1, hi);
-				if (e && !greenInside(*e)) e.reset();
-			}
+			const auto& e = edges[j];
 			if (!e) continue;
 			const double c = origin[j] + inward * (*e - half);
 			Eigen::Vector2d pt =

@@ -151,6 +151,18 @@ struct SubpixelParams
 	 * frame) and, failing that, at the G derivative's peak. Noise on a fill of
 	 * exactly 255 averages below 254.5. */
 	double saturation_level = 254.5;
+	/** On sides where G clips, restore the clipped samples from a
+	 * blurred-step model of B, G and R fitted with them censored, then read
+	 * the edges as on an unsaturated side (imputeClippedSide()): the clip
+	 * cuts the bright half of the response and the estimates above make the
+	 * square look 0.05-0.7 px larger at gains of 1.05-1.6, and noise clipped
+	 * on a fill at exactly 255 about 0.025 px. */
+	bool model_clipping = true;
+	/** ... on sides where more than this fraction of the fill's samples
+	 * beyond the search window (G >= 128: not a code cell) are at 255. A
+	 * fill at exactly the top clips half of them through its noise; a JPEG's
+	 * ringing next to an unclipped fill a few. */
+	double clipped_fraction = 0.25;
 	/** Where the black frame is narrower than this across a side [px], its
 	 * outer edge overlaps the inner edge's response: the edge is then taken
 	 * at the derivative's peak (Gaussian through three samples), which the

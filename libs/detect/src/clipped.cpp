@@ -1,0 +1,507 @@
+// Stage 7, sides whose green fill clips: the clipped samples restored from
+// an edge model fitted with the clip.
+//
+// Written by hand: OpenCV has no censored (Tobit) fit, and a general
+// least-squares solver (cv::LMSolver) cannot take the one-sided terms of
+// the clipped samples or the bounds on the levels.
+#include "stages.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace codemark::detect
+{
+namespace
+{
+constexpr double kSqrt2 = 1.4142135623730951;
+constexpr double kInvSqrt2Pi = 0.3989422804014327;
+constexpr int kChannels = 3;
+constexpr int kG = 1;  // BGR
+// Parameters of a side: its inner edge's across coordinate as a quadratic
+// in the normalised along coordinate (a lens bends a line a little), the
+// blur, the black frame's width (linear along the side: perspective), and
+// per channel the levels outside the frame, in it and in the fill.
+constexpr int kE0 = 0, kSigma = 3, kW0 = 4, kW1 = 5, kLevel = 6;
+// The black frame and the white margin are neutral (black ink, white
+// paper: equal in B, G and R after white balance), which a thin frame
+// needs: its own samples barely reach the black level. The fill is not.
+constexpr int kParams = kLevel + 2 + kChannels;
+using Vec = Eigen::Matrix<double, kParams, 1>;
+using Mat = Eigen::Matrix<double, kParams, kParams>;
+int outsideOf(int) { return kLevel; }
+int frameOf(int) { return kLevel + 1; }
+int fillOf(int c) { return kLevel + 2 + c; }
+
+/** Below this frame width [px] the frame's samples never reach its black
+ * level, and the levels, the blur and the two edges trade off: no model. */
+constexpr double kMinFramePx = 3.5;
+/** Frames narrower than this [px] have their outer edge in the model: its
+ * blur reaches the inner edge's samples (and, at gains above 1.1, the white
+ * margin clips too). */
+constexpr double kOuterModelPx = 7;
+/** The other edges' blur reaches about this far [px]. */
+constexpr double kClearPx = 2.2;
+/** A sharp edge (little blur beyond the pixel) has one mixed sample per
+ * profile: once it clips, where the edge lies within that pixel is
+ * ambiguous and the model is not used. */
+constexpr double kMinSigmaPx = 0.4;
+/** Largest blur [px] and level [grey levels, before the clip] accepted. */
+constexpr double kMaxSigmaPx = 2.0;
+constexpr double kMaxLevel = 4 * 255;
+/** The fit's residual noise may exceed the frame's by this factor plus
+ * this floor [grey levels] (the model's own shape error, quantisation). */
+constexpr double kMisfitFactor = 1.5;
+constexpr double kMisfitFloor = 1.5;
+/** Largest standard deviation of the side's fitted offset accepted [px]. */
+constexpr double kMaxOffsetSdPx = 0.05;
+/** Smallest contrast of R + B between the frame and the fill that gives G's
+ * fill level from the channels' ratio [grey levels], at least this many
+ * pixels' worth of step, and the largest predicted G of those pixels. */
+constexpr double kMinRbStep = 12;
+constexpr double kMinRatioSamples = 20;
+constexpr double kUnclippedG = 240;
+/** The fill counts as clipped throughout at this fraction of its samples
+ * at 255. */
+constexpr double kAllClippedFraction = 0.9;
+/** Profiles of a side used by the side's fit, evenly spread. */
+constexpr size_t kMaxProfiles = 48;
+
+double Phi(double u) { return 0.5 * std::erfc(-u / kSqrt2); }
+double phi(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
+
+/** A Gaussian-blurred unit step (blur \a sigma) averaged over the pixel
+ * [x - 1/2, x + 1/2] that samples it, and its derivatives with respect to x
+ * and sigma (the integral of Phi is z Phi(z) + phi(z)). An erf of a wider
+ * sigma instead misfits the steep part by about 1% of the step. */
+struct PixelStep
+{
+	double value, d_x, d_sigma;
+};
+PixelStep pixelStep(double x, double sigma)
+{
+	const double zp = (x + 0.5) / sigma, zm = (x - 0.5) / sigma;
+	const double Pp = Phi(zp), Pm = Phi(zm), fp = phi(zp), fm = phi(zm);
+	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+}
+
+/** -log Phi(z) and its first two derivatives with respect to z (through
+ * the inverse Mills ratio), stable far in the lower tail. */
+void censoredTerm(double z, double& nll, double& d1, double& d2)
+{
+	if (z < -30)
+	{
+		// Phi(z) ~ phi(z) / -z.
+		nll = 0.5 * z * z + std::log(-z) + 0.5 * std::log(2 * M_PI);
+		d1 = z;
+		d2 = 1;
+		return;
+	}
+	const double P = Phi(z);
+	const double lambda = phi(z) / P;
+	nll = -std::log(P);
+	d1 = -lambda;
+	d2 = lambda * (z + lambda);
+}
+
+/** Negative log-likelihood of one sample \a v (0..255) given the model
+ * value \a m and the pixel noise \a sn, and its first (\a a) and
+ * Gauss-Newton second (\a h) derivatives with respect to m. A sample at 255
+ * (0) says only that the sensor's input was at least 254.5 (at most 0.5): a
+ * censored (Tobit) term. Residuals beyond kHuber noise sigmas count
+ * linearly (a spot on the sheet, another edge). */
+double sampleTerm(int v, double m, double sn, double& a, double& h)
+{
+	constexpr double kHuber = 3;
+	double nll = 0, d1 = 0, d2 = 0;
+	if (v >= 255 || v <= 0)
+	{
+		const double sign = v >= 255 ? 1 : -1;
+		censoredTerm(sign * (m - (v >= 255 ? 254.5 : 0.5)) / sn, nll, d1, d2);
+		a = sign * d1 / sn;
+		h = d2 / (sn * sn);
+		return nll;
+	}
+	const double r = (m - v) / sn;
+	const double w = std::abs(r) <= kHuber ? 1.0 : kHuber / std::abs(r);
+	a = w * r / sn;
+	h = w / (sn * sn);
+	return w == 1.0 ? 0.5 * r * r : kHuber * (std::abs(r) - 0.5 * kHuber);
+}
+
+struct Window
+{
+	int j;	//!< profile
+	int i0, i1;	 //!< sample range, inclusive
+	double tau;	 //!< normalised along coordinate
+};
+
+/** The model of one side's profiles. */
+struct SideModel
+{
+	const ClippedSideProfiles& s;
+	bool outer;	 //!< the frame's outer edge is modelled
+	double tmid = 0, thalf = 1;
+
+	double tau(int j) const { return (s.along[j] - tmid) / thalf; }
+	/** Profile index of the across coordinate c in profile j, and back. */
+	double indexOf(int j, double c) const { return s.inward * (c - s.base[j]); }
+	double acrossOf(int j, double e) const { return s.base[j] + s.inward * e; }
+	static double edgeAt(const Vec& p, double t) { return p[0] + p[1] * t + p[2] * t * t; }
+	static double widthAt(const Vec& p, double t) { return p[kW0] + p[kW1] * t; }
+	int sample(int j, int i, int c) const { return s.bgr[(size_t(j) * s.n + i) * 3 + c]; }
+
+	/** Model value of channel c at sample i of a profile whose inner edge is
+	 * at index e and whose frame is w wide; with the Jacobian row (the inner
+	 * edge's index position in J[kE0]) when J is given. */
+	double value(const Vec& p, int c, int i, double e, double w, Vec* J) const
+	{
+		const double sigma = p[kSigma];
+		const PixelStep in = pixelStep(i - e, sigma);
+		const PixelStep out = outer ? pixelStep(i - (e - w), sigma) : PixelStep{1, 0, 0};
+		const double W = p[outsideOf(c)], lo = p[frameOf(c)], hi = p[fillOf(c)];
+		if (J)
+		{
+			J->setZero();
+			(*J)[kE0] = -(hi - lo) * in.d_x - (lo - W) * out.d_x;
+			(*J)[kSigma] = (lo - W) * out.d_sigma + (hi - lo) * in.d_sigma;
+			(*J)[kW0] = (lo - W) * out.d_x;
+			(*J)[outsideOf(c)] = 1 - out.value;
+			(*J)[frameOf(c)] = out.value - in.value;
+			(*J)[fillOf(c)] = in.value;
+		}
+		return W + (lo - W) * out.value + (hi - lo) * in.value;
+	}
+};
+}  // namespace
+
+double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
+{
+	// The diagonals' intersection.
+	const Eigen::Vector3d d1 = Eigen::Vector3d(q[0].x(), q[0].y(), 1).cross(Eigen::Vector3d(q[2].x(), q[2].y(), 1));
+	const Eigen::Vector3d d2 = Eigen::Vector3d(q[1].x(), q[1].y(), 1).cross(Eigen::Vector3d(q[3].x(), q[3].y(), 1));
+	const Eigen::Vector3d c = d1.cross(d2);
+	if (std::abs(c.z()) < 1e-12) return 0;
+	const double cx = c.x() / c.z(), cy = c.y() / c.z();
+	const double side = 0.25 * ((q[1] - q[0]).norm() + (q[2] - q[1]).norm() + (q[3] - q[2]).norm() +
+								(q[0] - q[3]).norm());
+	// Half the cell, less the reach of a blur and of JPEG ringing.
+	const int h = static_cast<int>(std::floor(0.5 * cell_rel * side - 2.5));
+	if (h < 1) return 0;
+	const int x0 = static_cast<int>(std::lround(cx)) - h, y0 = static_cast<int>(std::lround(cy)) - h;
+	if (x0 < 0 || y0 < 0 || x0 + 2 * h + 1 >= bgr.cols || y0 + 2 * h >= bgr.rows) return 0;
+	std::vector<double> diffs;
+	for (int y = y0; y <= y0 + 2 * h; ++y)
+	{
+		const uint8_t* row = bgr.ptr<uint8_t>(y);
+		for (int x = x0; x <= x0 + 2 * h; ++x)
+			diffs.push_back(std::abs(double(row[3 * (x + 1) + 1]) - row[3 * x + 1]));
+	}
+	std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
+	// The difference of two samples has sqrt(2) sigma; its median absolute
+	// value is 0.6745 of that.
+	return diffs[diffs.size() / 2] / (0.6745 * std::sqrt(2.0));
+}
+
+bool imputeClippedSide(
+	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
+	double frame_px, double fill_px, double noise, double clipped_fraction,
+	std::vector<int>& g_profiles)
+{
+	const int np = static_cast<int>(s.along.size());
+	if (np == 0 || static_cast<int>(initial.size()) != np || s.n < 5 ||
+		g_profiles.size() != size_t(np) * s.n || frame_px < kMinFramePx)
+		return false;
+	SideModel M{s, frame_px < kOuterModelPx};
+	// Where part of the fill is unclipped, G alone gives its level (the
+	// censored fit sees both sides of the clip). Where all of it clips, its
+	// level would come from the shape of the few unclipped samples of the
+	// edge, which a model's shape error (about 1% of the step) moves by
+	// several percent: B and R (unclipped) then join the fit, and give the
+	// level through their ratio below. Not before: a JPEG's subsampled
+	// chroma or a camera's demosaicing make them a blurred, shifted copy.
+	const bool rb = clipped_fraction >= kAllClippedFraction;
+	const int c_first = rb ? 0 : kG, c_last = rb ? 2 : kG;
+	const auto [tmin, tmax] = std::minmax_element(s.along.begin(), s.along.end());
+	M.tmid = 0.5 * (*tmin + *tmax);
+	M.thalf = std::max(1.0, 0.5 * (*tmax - *tmin));
+
+	// The initial edge as a robust quadratic in tau.
+	std::vector<int> use;
+	for (int j = 0; j < np; ++j)
+		if (initial[j]) use.push_back(j);
+	if (use.size() < 8) return false;
+	Vec p = Vec::Zero();
+	for (int it = 0; it < 3; ++it)
+	{
+		Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+		Eigen::Vector3d b = Eigen::Vector3d::Zero();
+		for (const int j : use)
+		{
+			const double t = M.tau(j);
+			const Eigen::Vector3d x(1, t, t * t);
+			A += x * x.transpose();
+			b += x * M.acrossOf(j, *initial[j]);
+		}
+		p.head<3>() = A.ldlt().solve(b);
+		std::vector<int> kept;
+		for (const int j : use)
+			if (std::abs(M.acrossOf(j, *initial[j]) - SideModel::edgeAt(p, M.tau(j))) < 1.0)
+				kept.push_back(j);
+		if (kept.size() < 8) return false;
+		use.swap(kept);
+	}
+	const double e0_initial = p[kE0];
+	p[kW0] = frame_px;
+
+	// The samples: from just outside the frame (outer edge modelled) or a
+	// few into it (clear of its outer edge's blur), to a few into the fill
+	// (clear of the code board).
+	const auto windowOf = [&](int j, double e, double w) -> std::optional<Window>
+	{
+		const int fe = static_cast<int>(std::floor(e)), ce = static_cast<int>(std::ceil(e));
+		const int i0 = M.outer ? static_cast<int>(std::ceil(e - w + 0.5))
+							   : std::clamp(
+									 static_cast<int>(std::ceil(e - (frame_px - kClearPx))), fe - 4,
+									 fe - 1);
+		const int i1 = std::clamp(static_cast<int>(std::floor(e + fill_px - kClearPx)), ce + 1, ce + 4);
+		if (i0 < 0 || i1 >= s.n) return std::nullopt;
+		return Window{j, i0, i1, M.tau(j)};
+	};
+	std::vector<Window> windows;
+	const size_t stride = (use.size() + kMaxProfiles - 1) / kMaxProfiles;
+	for (size_t k = 0; k < use.size(); k += stride)
+	{
+		const int j = use[k];
+		if (const auto w = windowOf(j, M.indexOf(j, SideModel::edgeAt(p, M.tau(j))), frame_px))
+			windows.push_back(*w);
+	}
+	if (windows.size() < 6) return false;
+
+	// Initial levels: outside from the window's first sample, the frame's
+	// from its middle (outer edge modelled) or first sample, the fill's
+	// from the window's last; a clipped fill lies somewhere above the top.
+	for (int c = 0; c < kChannels; ++c)
+	{
+		double W = 0, lo = 0, hi = 0;
+		for (const Window& w : windows)
+		{
+			const double e = M.indexOf(w.j, SideModel::edgeAt(p, w.tau));
+			W += M.sample(w.j, w.i0, c);
+			lo += M.outer ? M.sample(w.j, std::max(w.i0, static_cast<int>(std::lround(e - 0.5 * frame_px))), c)
+						  : M.sample(w.j, w.i0, c);
+			hi += M.sample(w.j, w.i1, c);
+		}
+		const double k = 1.0 / windows.size();
+		p[outsideOf(c)] += W * k / kChannels;
+		p[frameOf(c)] += lo * k / kChannels;
+		p[fillOf(c)] = hi * k >= 254 ? 300 : hi * k;
+	}
+	p[kSigma] = 0.8;
+
+	// Parameters the data cannot move: without the outer edge, its width
+	// and the outside levels.
+	std::vector<int> fixed;
+	for (int c = 0; c < kChannels; ++c)
+		if (c < c_first || c > c_last) fixed.push_back(fillOf(c));
+	if (!M.outer)
+	{
+		fixed.insert(fixed.end(), {kW0, kW1});
+		for (int c = 0; c < kChannels; ++c) fixed.push_back(outsideOf(c));
+	}
+	// The side's negative log-likelihood, its gradient and Gauss-Newton
+	// Hessian; sn the pixel noise; the sum of squares of the unclipped
+	// residuals through ss, nss.
+	const auto evaluate = [&](const Vec& q, double sn, Vec* g, Mat* H, double* ss, int* nss)
+	{
+		double nll = 0;
+		if (g) g->setZero();
+		if (H) H->setZero();
+		Vec J;
+		for (const Window& w : windows)
+		{
+			const double e = M.indexOf(w.j, SideModel::edgeAt(q, w.tau));
+			const double width = SideModel::widthAt(q, w.tau);
+			for (int i = w.i0; i <= w.i1; ++i)
+				for (int c = c_first; c <= c_last; ++c)
+				{
+					const double m = M.value(q, c, i, e, width, g ? &J : nullptr);
+					const int v = M.sample(w.j, i, c);
+					double a = 0, h = 0;
+					nll += sampleTerm(v, m, sn, a, h);
+					if (ss && v > 0 && v < 255)
+					{
+						*ss += (m - v) * (m - v);
+						++*nss;
+					}
+					if (!g) continue;
+					// The edge's index moves with its across coordinate by
+					// the inward sign, the coefficients by powers of tau.
+					const double de = J[kE0] * s.inward;
+					J[0] = de;
+					J[1] = de * w.tau;
+					J[2] = de * w.tau * w.tau;
+					J[kW1] = J[kW0] * w.tau;
+					*g += a * J;
+					*H += h * J * J.transpose();
+				}
+		}
+		return nll;
+	};
+	// Held parameters (fixed ones, levels at their bound of zero pushed
+	// further down) leave the step: projected Levenberg-Marquardt.
+	const auto hold = [&](const Vec& q, const Vec& g, Mat& A, Vec& gg)
+	{
+		gg = g;
+		const auto freeze = [&](int k)
+		{
+			A.row(k).setZero();
+			A.col(k).setZero();
+			A(k, k) = 1;
+			gg[k] = 0;
+		};
+		for (const int k : fixed) freeze(k);
+		for (int k = kLevel; k < kParams; ++k)
+			if (q[k] <= 0 && g[k] > 0) freeze(k);
+	};
+	const auto solve = [&](Vec q, double sn, int iterations)
+	{
+		double mu = 1e-3;
+		Vec g, gg;
+		Mat H;
+		double nll = evaluate(q, sn, &g, &H, nullptr, nullptr);
+		for (int it = 0; it < iterations && mu < 1e6; ++it)
+		{
+			Mat A = H;
+			A.diagonal() += mu * H.diagonal().cwiseMax(1e-9);
+			hold(q, g, A, gg);
+			const Vec step = -A.ldlt().solve(gg);
+			if (!step.allFinite()) break;
+			Vec cand = q + step;
+			cand[kSigma] = std::clamp(cand[kSigma], 0.2, 4.0);
+			cand[kW0] = std::max(0.5, cand[kW0]);
+			// Light is never negative: a fill at the sensor's floor (R and B
+			// of a pure green) must not drift below it.
+			for (int k = kLevel; k < kParams; ++k) cand[k] = std::max(0.0, cand[k]);
+			const double nll_c = evaluate(cand, sn, nullptr, nullptr, nullptr, nullptr);
+			if (nll_c < nll)
+			{
+				q = cand;
+				mu = std::max(1e-7, mu * 0.3);
+				nll = evaluate(q, sn, &g, &H, nullptr, nullptr);
+				if (std::abs(step[kE0]) < 1e-5 && std::abs(step[kSigma]) < 1e-5) break;
+			}
+			else
+				mu *= 10;
+		}
+		return q;
+	};
+	// Fit with a nominal noise, estimate the noise from the unclipped
+	// residuals, fit again.
+	constexpr double kNominalNoise = 2.0;
+	p = solve(p, kNominalNoise, 30);
+	double ss = 0;
+	int nss = 0;
+	evaluate(p, kNominalNoise, nullptr, nullptr, &ss, &nss);
+	const double sn = nss > 10 ? std::clamp(std::sqrt(ss / nss), 0.5, 20.0) : kNominalNoise;
+	p = solve(p, sn, 30);
+	// The clip leaves G's fill level to the shape of the few unclipped
+	// samples of its edge, where the model's shape error (about 1% of the
+	// step) moves it by several percent. R and B see the same optics at the
+	// same pixels, unclipped: where they have contrast, each pixel of the
+	// inner edge gives its share F of the step, and G's step is the ratio
+	// of sums of (G - frame level) and F over the unclipped ones (chosen by
+	// the model's values, not the noisy samples). Then fit again with it.
+	{
+		const double lo_rb = p[frameOf(0)] + p[frameOf(2)];
+		const double step_rb = lo_rb - p[fillOf(0)] - p[fillOf(2)];
+		double num = 0, den = 0;
+		if (rb && step_rb >= kMinRbStep)
+			for (const Window& w : windows)
+			{
+				const double e = M.indexOf(w.j, SideModel::edgeAt(p, w.tau));
+				const double width = SideModel::widthAt(p, w.tau);
+				for (int i = std::max(w.i0, static_cast<int>(std::ceil(e - 1.5))); i <= w.i1; ++i)
+				{
+					const double F_model = pixelStep(i - e, p[kSigma]).value;
+					if (F_model < 0.1 || F_model > 0.9 ||
+						M.value(p, kG, i, e, width, nullptr) > kUnclippedG)
+						continue;
+					num += M.sample(w.j, i, kG) - p[frameOf(kG)];
+					den += (lo_rb - M.sample(w.j, i, 0) - M.sample(w.j, i, 2)) / step_rb;
+				}
+			}
+		if (den > kMinRatioSamples * 0.5)
+		{
+			p[fillOf(kG)] = p[frameOf(kG)] + num / den;
+			fixed.push_back(fillOf(kG));
+			p = solve(p, sn, 30);
+		}
+	}
+	// The fit must explain the samples to about the sensor's noise where
+	// the caller could measure it (0: not measured): a JPEG's subsampled
+	// chroma, a gamma curve or a spot on the sheet make the samples disagree
+	// with the model, which is then not used.
+	const bool misfit = noise > 0 && sn > kMisfitFactor * std::max(0.5, noise) + kMisfitFloor;
+	if (!p.allFinite() || std::abs(p[kE0] - e0_initial) > 1.5 || p[kSigma] < kMinSigmaPx ||
+		p[kSigma] > kMaxSigmaPx || p[outsideOf(0)] > kMaxLevel || p[fillOf(kG)] > kMaxLevel ||
+		misfit)
+		return false;
+	{
+		Vec g, gg;
+		Mat H;
+		evaluate(p, sn, &g, &H, nullptr, nullptr);
+		hold(p, g, H, gg);
+		const double var = H.inverse()(kE0, kE0);
+		if (!(var >= 0) || std::sqrt(var) > kMaxOffsetSdPx) return false;
+	}
+
+	// Each profile's own edge with the side's blur, frame width and levels
+	// (a Newton iteration on its position alone, from the side's curve),
+	// then its clipped G samples on the fill side (and, with the outer edge
+	// modelled, outside the frame) replaced by their expectation given that
+	// model and the clip: E[v | v >= 254.5] = m + sn lambda(z).
+	for (int j = 0; j < np; ++j)
+	{
+		const double t = M.tau(j);
+		const double width = SideModel::widthAt(p, t);
+		double e = M.indexOf(j, SideModel::edgeAt(p, t));
+		const double e_side = e;
+		if (const auto w = windowOf(j, e, width))
+		{
+			Vec J;
+			for (int it = 0; it < 8; ++it)
+			{
+				double grad = 0, hess = 0;
+				for (int i = w->i0; i <= w->i1; ++i)
+					for (int c = c_first; c <= c_last; ++c)
+					{
+						double a = 0, h = 0;
+						sampleTerm(M.sample(j, i, c), M.value(p, c, i, e, width, &J), sn, a, h);
+						grad += a * J[kE0];
+						hess += h * J[kE0] * J[kE0];
+					}
+				if (!(hess > 0)) break;
+				const double step = std::clamp(-grad / hess, -0.5, 0.5);
+				e += step;
+				if (std::abs(step) < 1e-5) break;
+			}
+			if (!(std::abs(e - e_side) < 1.5)) e = e_side;
+		}
+		int* g = g_profiles.data() + size_t(j) * s.n;
+		for (int i = 0; i < s.n; ++i)
+		{
+			if (g[i] < 255) continue;
+			const bool fill_side = i >= std::floor(e);
+			const bool outside = M.outer && i <= std::ceil(e - width);
+			if (!fill_side && !outside) continue;
+			const double m = M.value(p, kG, i, e, width, nullptr);
+			double nll = 0, d1 = 0, d2 = 0;
+			censoredTerm((m - 254.5) / sn, nll, d1, d2);
+			g[i] = static_cast<int>(std::lround(m - sn * d1));	// d1 = -lambda(z)
+		}
+	}
+	return true;
+}
+
+}  // namespace codemark::detect
