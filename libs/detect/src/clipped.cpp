@@ -64,8 +64,10 @@ constexpr double kUnclippedG = 240;
 /** The fill counts as clipped throughout at this fraction of its samples
  * at 255. */
 constexpr double kAllClippedFraction = 0.9;
+/** Fewest fill-band samples a side needs. */
+constexpr size_t kMinFillSamples = 20;
 /** Profiles of a side used by the side's fit, evenly spread. */
-constexpr size_t kMaxProfiles = 48;
+constexpr size_t kMaxProfiles = 20;
 
 double Phi(double u) { return 0.5 * std::erfc(-u / kSqrt2); }
 double phi(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
@@ -157,8 +159,14 @@ struct SideModel
 	double value(const Vec& p, int c, int i, double e, double w, Vec* J) const
 	{
 		const double sigma = p[kSigma];
-		const PixelStep in = pixelStep(i - e, sigma);
-		const PixelStep out = outer ? pixelStep(i - (e - w), sigma) : PixelStep{1, 0, 0};
+		return value(
+			p, c, pixelStep(i - e, sigma),
+			outer ? pixelStep(i - (e - w), sigma) : PixelStep{1, 0, 0}, J);
+	}
+	/** The same from the inner and outer edges' steps at the sample (the
+	 * same in every channel). */
+	static double value(const Vec& p, int c, const PixelStep& in, const PixelStep& out, Vec* J)
+	{
 		const double W = p[outsideOf(c)], lo = p[frameOf(c)], hi = p[fillOf(c)];
 		if (J)
 		{
@@ -173,6 +181,77 @@ struct SideModel
 		return W + (lo - W) * out.value + (hi - lo) * in.value;
 	}
 };
+}  // namespace
+
+namespace
+{
+/** z with Phi(z) = q, 0 < q < 1 (Newton from the logistic guess). */
+double inverseNormalCdf(double q)
+{
+	double z = std::log(q / (1 - q)) / 1.7;
+	for (int it = 0; it < 8; ++it) z -= (Phi(z) - q) / std::max(1e-300, phi(z));
+	return z;
+}
+
+/** The fill band's G samples of a side (beyond the inner edge's blur,
+ * short of the code board's): those at 255 and the others. */
+struct FillSamples
+{
+	int clipped = 0;
+	std::vector<int> unclipped;
+	double clippedFraction() const
+	{
+		const double n = clipped + static_cast<double>(unclipped.size());
+		return n > 0 ? clipped / n : 0;
+	}
+};
+FillSamples fillSamples(
+	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
+	const std::vector<int>& g_profiles, double fill_px)
+{
+	FillSamples f;
+	for (size_t j = 0; j < s.along.size(); ++j)
+	{
+		if (!initial[j]) continue;
+		const int* g = g_profiles.data() + j * s.n;
+		const int i1 = std::min(s.n - 1, static_cast<int>(std::floor(*initial[j] + fill_px - 2.2)));
+		for (int i = static_cast<int>(std::ceil(*initial[j])) + 2; i <= i1; ++i)
+			if (g[i] >= 255)
+				++f.clipped;
+			else
+				f.unclipped.push_back(g[i]);
+	}
+	return f;
+}
+
+/** imputeClippedSide() where part of the fill is unclipped. */
+bool imputeClippedNoise(
+	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
+	FillSamples f, std::vector<int>& g_profiles)
+{
+	if (f.unclipped.size() < 10 || f.clipped < 10) return false;
+	// 254.5 is the (1 - p_c) quantile, the unclipped median the
+	// (1 - p_c) / 2 one.
+	const double p_c = f.clippedFraction();
+	auto& u = f.unclipped;
+	std::nth_element(u.begin(), u.begin() + u.size() / 2, u.end());
+	const double median = u[u.size() / 2];
+	const double z_c = inverseNormalCdf(1 - p_c), z_m = inverseNormalCdf(0.5 * (1 - p_c));
+	const double sigma = (254.5 - median) / (z_c - z_m);
+	if (!(sigma > 0.1) || !std::isfinite(sigma)) return false;
+	const double mu = 254.5 - sigma * z_c;
+	// E[v | v >= 254.5] = mu + sigma phi(z_c) / (1 - Phi(z_c)).
+	const int imputed =
+		static_cast<int>(std::lround(mu + sigma * phi(z_c) / std::max(1e-12, 1 - Phi(z_c))));
+	for (size_t j = 0; j < s.along.size(); ++j)
+	{
+		if (!initial[j]) continue;
+		int* g = g_profiles.data() + j * s.n;
+		for (int i = static_cast<int>(std::floor(*initial[j])) + 1; i < s.n; ++i)
+			if (g[i] >= 255) g[i] = imputed;
+	}
+	return true;
+}
 }  // namespace
 
 double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
@@ -205,13 +284,22 @@ double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 
 bool imputeClippedSide(
 	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
-	double frame_px, double fill_px, double noise, double clipped_fraction,
-	std::vector<int>& g_profiles)
+	double frame_px, double fill_px, double noise, std::vector<int>& g_profiles)
 {
 	const int np = static_cast<int>(s.along.size());
 	if (np == 0 || static_cast<int>(initial.size()) != np || s.n < 5 ||
 		g_profiles.size() != size_t(np) * s.n || frame_px < kMinFramePx)
 		return false;
+	// Part of the fill unclipped: only its noise clips. Its level and noise
+	// follow from where the clip cuts the samples' distribution and from
+	// their unclipped median (a censored normal), and every clipped sample
+	// beyond the edge's midpoint gets the expectation of a sample above the
+	// clip, without a model of the edge (the few transition samples that
+	// clip are within a noise sigma of the fill).
+	const FillSamples fill = fillSamples(s, initial, g_profiles, fill_px);
+	if (fill.clipped + fill.unclipped.size() < kMinFillSamples) return false;
+	if (fill.clippedFraction() < kAllClippedFraction)
+		return imputeClippedNoise(s, initial, fill, g_profiles);
 	SideModel M{s, frame_px < kOuterModelPx};
 	// Where part of the fill is unclipped, G alone gives its level (the
 	// censored fit sees both sides of the clip). Where all of it clips, its
@@ -220,8 +308,8 @@ bool imputeClippedSide(
 	// several percent: B and R (unclipped) then join the fit, and give the
 	// level through their ratio below. Not before: a JPEG's subsampled
 	// chroma or a camera's demosaicing make them a blurred, shifted copy.
-	const bool rb = clipped_fraction >= kAllClippedFraction;
-	const int c_first = rb ? 0 : kG, c_last = rb ? 2 : kG;
+	const bool rb = true;
+	const int c_first = 0, c_last = 2;
 	const auto [tmin, tmax] = std::minmax_element(s.along.begin(), s.along.end());
 	M.tmid = 0.5 * (*tmin + *tmax);
 	M.thalf = std::max(1.0, 0.5 * (*tmax - *tmin));
@@ -306,7 +394,8 @@ bool imputeClippedSide(
 		if (c < c_first || c > c_last) fixed.push_back(fillOf(c));
 	if (!M.outer)
 	{
-		fixed.insert(fixed.end(), {kW0, kW1});
+		fixed.push_back(kW0);
+		fixed.push_back(kW1);
 		for (int c = 0; c < kChannels; ++c) fixed.push_back(outsideOf(c));
 	}
 	// The side's negative log-likelihood, its gradient and Gauss-Newton
@@ -318,14 +407,18 @@ bool imputeClippedSide(
 		if (g) g->setZero();
 		if (H) H->setZero();
 		Vec J;
+		const double sigma = q[kSigma];
 		for (const Window& w : windows)
 		{
 			const double e = M.indexOf(w.j, SideModel::edgeAt(q, w.tau));
 			const double width = SideModel::widthAt(q, w.tau);
 			for (int i = w.i0; i <= w.i1; ++i)
+			{
+				const PixelStep in = pixelStep(i - e, sigma);
+				const PixelStep out = M.outer ? pixelStep(i - (e - width), sigma) : PixelStep{1, 0, 0};
 				for (int c = c_first; c <= c_last; ++c)
 				{
-					const double m = M.value(q, c, i, e, width, g ? &J : nullptr);
+					const double m = SideModel::value(q, c, in, out, g ? &J : nullptr);
 					const int v = M.sample(w.j, i, c);
 					double a = 0, h = 0;
 					nll += sampleTerm(v, m, sn, a, h);
@@ -343,9 +436,11 @@ bool imputeClippedSide(
 					J[2] = de * w.tau * w.tau;
 					J[kW1] = J[kW0] * w.tau;
 					*g += a * J;
-					*H += h * J * J.transpose();
+					H->selfadjointView<Eigen::Lower>().rankUpdate(J, h);
 				}
+			}
 		}
+		if (H) *H = H->selfadjointView<Eigen::Lower>();
 		return nll;
 	};
 	// Held parameters (fixed ones, levels at their bound of zero pushed
@@ -367,8 +462,8 @@ bool imputeClippedSide(
 	const auto solve = [&](Vec q, double sn, int iterations)
 	{
 		double mu = 1e-3;
-		Vec g, gg;
-		Mat H;
+		Vec g, gg, g_c;
+		Mat H, H_c;
 		double nll = evaluate(q, sn, &g, &H, nullptr, nullptr);
 		for (int it = 0; it < iterations && mu < 1e6; ++it)
 		{
@@ -383,28 +478,31 @@ bool imputeClippedSide(
 			// Light is never negative: a fill at the sensor's floor (R and B
 			// of a pure green) must not drift below it.
 			for (int k = kLevel; k < kParams; ++k) cand[k] = std::max(0.0, cand[k]);
-			const double nll_c = evaluate(cand, sn, nullptr, nullptr, nullptr, nullptr);
+			const double nll_c = evaluate(cand, sn, &g_c, &H_c, nullptr, nullptr);
 			if (nll_c < nll)
 			{
 				q = cand;
+				nll = nll_c;
+				g = g_c;
+				H = H_c;
 				mu = std::max(1e-7, mu * 0.3);
-				nll = evaluate(q, sn, &g, &H, nullptr, nullptr);
-				if (std::abs(step[kE0]) < 1e-5 && std::abs(step[kSigma]) < 1e-5) break;
+				if (std::abs(step[kE0]) < 1e-4 && std::abs(step[kSigma]) < 1e-4) break;
 			}
 			else
 				mu *= 10;
 		}
 		return q;
 	};
-	// Fit with a nominal noise, estimate the noise from the unclipped
-	// residuals, fit again.
+	// Fit with the measured noise (or a nominal one), estimate the noise
+	// from the unclipped residuals, and refine with it.
 	constexpr double kNominalNoise = 2.0;
-	p = solve(p, kNominalNoise, 30);
+	const double sn0 = kNominalNoise;
+	p = solve(p, sn0, 20);
 	double ss = 0;
 	int nss = 0;
-	evaluate(p, kNominalNoise, nullptr, nullptr, &ss, &nss);
-	const double sn = nss > 10 ? std::clamp(std::sqrt(ss / nss), 0.5, 20.0) : kNominalNoise;
-	p = solve(p, sn, 30);
+	evaluate(p, sn0, nullptr, nullptr, &ss, &nss);
+	const double sn = nss > 10 ? std::clamp(std::sqrt(ss / nss), 0.5, 20.0) : sn0;
+	p = solve(p, sn, 5);
 	// The clip leaves G's fill level to the shape of the few unclipped
 	// samples of its edge, where the model's shape error (about 1% of the
 	// step) moves it by several percent. R and B see the same optics at the
@@ -435,7 +533,7 @@ bool imputeClippedSide(
 		{
 			p[fillOf(kG)] = p[frameOf(kG)] + num / den;
 			fixed.push_back(fillOf(kG));
-			p = solve(p, sn, 30);
+			p = solve(p, sn, 10);
 		}
 	}
 	// The fit must explain the samples to about the sensor's noise where
@@ -456,38 +554,17 @@ bool imputeClippedSide(
 		if (!(var >= 0) || std::sqrt(var) > kMaxOffsetSdPx) return false;
 	}
 
-	// Each profile's own edge with the side's blur, frame width and levels
-	// (a Newton iteration on its position alone, from the side's curve),
-	// then its clipped G samples on the fill side (and, with the outer edge
-	// modelled, outside the frame) replaced by their expectation given that
-	// model and the clip: E[v | v >= 254.5] = m + sn lambda(z).
+	// Each profile's clipped G samples on the fill side (and, with the outer
+	// edge modelled, outside the frame) replaced by their expectation given
+	// the side's model and the clip: E[v | v >= 254.5] = m + sn lambda(z).
+	// The side's curve places the edge in each profile: a profile's own fit
+	// would move it by its noise only, where the clipped samples' model
+	// values vary little with it.
 	for (int j = 0; j < np; ++j)
 	{
 		const double t = M.tau(j);
 		const double width = SideModel::widthAt(p, t);
-		double e = M.indexOf(j, SideModel::edgeAt(p, t));
-		const double e_side = e;
-		if (const auto w = windowOf(j, e, width))
-		{
-			Vec J;
-			for (int it = 0; it < 8; ++it)
-			{
-				double grad = 0, hess = 0;
-				for (int i = w->i0; i <= w->i1; ++i)
-					for (int c = c_first; c <= c_last; ++c)
-					{
-						double a = 0, h = 0;
-						sampleTerm(M.sample(j, i, c), M.value(p, c, i, e, width, &J), sn, a, h);
-						grad += a * J[kE0];
-						hess += h * J[kE0] * J[kE0];
-					}
-				if (!(hess > 0)) break;
-				const double step = std::clamp(-grad / hess, -0.5, 0.5);
-				e += step;
-				if (std::abs(step) < 1e-5) break;
-			}
-			if (!(std::abs(e - e_side) < 1.5)) e = e_side;
-		}
+		const double e = M.indexOf(j, SideModel::edgeAt(p, t));
 		int* g = g_profiles.data() + size_t(j) * s.n;
 		for (int i = 0; i < s.n; ++i)
 		{

@@ -165,29 +165,34 @@ struct ClippedSideProfiles
 };
 
 /** Restores the G profiles of a side whose green fill clips at the
- * sensor's top, so that the usual edge estimators can read them: a blurred
- * step in each of B, G and R, with the side's blur and levels and a
- * quadratic edge along it, is fitted by maximum likelihood with the samples
- * at 255 (or 0) censored (they say only "at least 254.5"); each clipped G
- * sample on the fill side of its profile's edge is then replaced by its
- * expectation under that model and the clip. The clip cuts the bright half
- * of the edge's response, which moves the derivative's peak and centroid
- * outwards, by 0.05-0.4 px at gains of 1.05-1.6 (the square looks larger);
- * the model is only used for the clipped samples, so its own shape error
- * (0.01-0.03 px) matters little where few are clipped. \a initial: each
- * profile's edge estimate [profile index] (nullopt: none); \a frame_px,
- * \a fill_px: the black frame's and the green band's widths across the side
- * [px] (the fitted samples stay clear of their other edges); \a noise: the
- * sensor's noise in G [grey levels] (centreCellNoise()); \a clipped_fraction:
- * the fraction of the fill-side samples at 255; \a g_profiles:
- * side.along.size() x side.n G samples, modified in place. Returns false,
- * leaving them as they were, when the side has too few edge points, the
- * fit does not converge near them, or the edge is too sharp (one mixed
- * sample per profile) for the model to say where a clipped edge lies. */
+ * sensor's top, so that the usual edge estimators can read them. The clip
+ * cuts the bright half of the edge's response, which moves the derivative's
+ * peak and centroid outwards (the square looks larger): by 0.012 px where
+ * only the noise of a fill at exactly 255 clips, 0.05 px at gains of
+ * 1.1-1.6 within 2 m and up to 0.5 px on 4-5 px frames.
+ * - Part of the fill band unclipped: its level and noise follow from where
+ *   the clip cuts its samples' distribution and from their unclipped median
+ *   (a censored normal); each clipped sample beyond the edge's midpoint gets
+ *   the expectation of a sample above the clip.
+ * - All of it clipped: a Gaussian-blurred, pixel-integrated step (with the
+ *   frame's outer edge below 7 px) in B, G and R, the side's blur and levels
+ *   shared and the edge a quadratic along the side, is fitted by maximum
+ *   likelihood with the samples at 255 or 0 censored (Tobit); G's fill level
+ *   comes from the unclipped channels' ratio; each clipped G sample on the
+ *   fill side (and outside a thin frame) gets its expectation under that
+ *   model and the clip. About 0.5 ms a side.
+ * \a initial: each profile's edge estimate [profile index] (nullopt: none);
+ * \a frame_px, \a fill_px: the black frame's and the green band's widths
+ * across the side [px]; \a noise: the sensor's noise in G [grey levels]
+ * (centreCellNoise(); 0: unknown); \a g_profiles: side.along.size() x
+ * side.n G samples, modified in place. Returns false, leaving them as they
+ * were, when the side has too few edge points or fill samples, its frame is
+ * under 3.5 px, the fit does not converge near them, the edge is too sharp
+ * (one mixed sample a profile) to say where a clipped edge lies, or the
+ * fit explains the samples worse than the noise (JPEG chroma). */
 bool imputeClippedSide(
 	const ClippedSideProfiles& side, const std::vector<std::optional<double>>& initial,
-	double frame_px, double fill_px, double noise, double clipped_fraction,
-	std::vector<int>& g_profiles);
+	double frame_px, double fill_px, double noise, std::vector<int>& g_profiles);
 
 /** The noise of G [grey levels] in the always-black centre code cell of the
  * quadrangle \a coarse (around its diagonals' intersection, the projected

@@ -358,7 +358,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		if (clips && noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
 		if (clips && imputeClippedSide(
 						 clip_side, edges, frame_px, frame_px * fill_ratio / frame_ratio, noise,
-						 double(fill_clipped) / fill_samples, g_prof))
+						 g_prof))
 			edges = locateAll(false);
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());

@@ -151,12 +151,13 @@ struct SubpixelParams
 	 * frame) and, failing that, at the G derivative's peak. Noise on a fill of
 	 * exactly 255 averages below 254.5. */
 	double saturation_level = 254.5;
-	/** On sides where G clips, restore the clipped samples from a
-	 * blurred-step model of B, G and R fitted with them censored, then read
-	 * the edges as on an unsaturated side (imputeClippedSide()): the clip
-	 * cuts the bright half of the response and the estimates above make the
-	 * square look 0.05-0.7 px larger at gains of 1.05-1.6, and noise clipped
-	 * on a fill at exactly 255 about 0.025 px. */
+	/** On sides where G clips, restore the clipped samples (from the fill's
+	 * censored noise distribution, or where all of the fill clips from an
+	 * edge model of B, G and R fitted with them censored), then read the
+	 * edges as on an unsaturated side (imputeClippedSide() in stages.h): the
+	 * clip cuts the bright half of the response and the estimates above make
+	 * each edge move outwards by 0.012 px where only a fill's noise clips,
+	 * 0.05 px at gains of 1.1-1.6 and up to 0.5 px on thin frames. */
 	bool model_clipping = true;
 	/** ... on sides where more than this fraction of the fill's samples
 	 * beyond the search window (G >= 128: not a code cell) are at 255. A
