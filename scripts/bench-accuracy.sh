@@ -31,7 +31,7 @@ if [[ $quick -eq 1 ]]; then
   exit 0
 fi
 echo "== C_P calibration (realistic scenes, as the shipped values)"
-"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75
+"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance
 echo "== C_P calibration (the accuracy map's flat background, for comparison)"
 "$calib" --renders 3000 --seed 7
 echo "== accuracy map"

