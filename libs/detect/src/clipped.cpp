@@ -61,11 +61,6 @@ constexpr double kMaxOffsetSdPx = 0.05;
 constexpr double kMinRbStep = 12;
 constexpr double kMinRatioSamples = 20;
 constexpr double kUnclippedG = 240;
-/** The fill counts as clipped throughout at this fraction of its samples
- * at 255. */
-constexpr double kAllClippedFraction = 0.9;
-/** Fewest fill-band samples a side needs. */
-constexpr size_t kMinFillSamples = 20;
 /** Profiles of a side used by the side's fit, evenly spread. */
 constexpr size_t kMaxProfiles = 20;
 
@@ -151,7 +146,7 @@ struct SideModel
 	double acrossOf(int j, double e) const { return s.base[j] + s.inward * e; }
 	static double edgeAt(const Vec& p, double t) { return p[0] + p[1] * t + p[2] * t * t; }
 	static double widthAt(const Vec& p, double t) { return p[kW0] + p[kW1] * t; }
-	int sample(int j, int i, int c) const { return s.bgr[(size_t(j) * s.n + i) * 3 + c]; }
+	int sample(int j, int i, int c) const { return s.sample(j, i, c); }
 
 	/** Model value of channel c at sample i of a profile whose inner edge is
 	 * at index e and whose frame is w wide; with the Jacobian row (the inner
@@ -193,66 +188,51 @@ double inverseNormalCdf(double q)
 	return z;
 }
 
-/** The fill band's G samples of a side (beyond the inner edge's blur,
- * short of the code board's): those at 255 and the others. */
-struct FillSamples
+}  // namespace
+
+ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1)
 {
-	int clipped = 0;
-	std::vector<int> unclipped;
-	double clippedFraction() const
-	{
-		const double n = clipped + static_cast<double>(unclipped.size());
-		return n > 0 ? clipped / n : 0;
-	}
-};
-FillSamples fillSamples(
-	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
-	const std::vector<int>& g_profiles, double fill_px)
-{
-	FillSamples f;
-	for (size_t j = 0; j < s.along.size(); ++j)
-	{
-		if (!initial[j]) continue;
-		const int* g = g_profiles.data() + j * s.n;
-		const int i1 = std::min(s.n - 1, static_cast<int>(std::floor(*initial[j] + fill_px - 2.2)));
-		for (int i = static_cast<int>(std::ceil(*initial[j])) + 2; i <= i1; ++i)
-			if (g[i] >= 255)
+	ClippedFill f;
+	i0 = std::max(0, i0);
+	i1 = std::min(n - 1, i1);
+	if (i1 < i0) return f;
+	for (size_t k = 0; k + n <= g_profiles.size(); k += n)
+		for (int i = i0; i <= i1; ++i)
+		{
+			const int v = g_profiles[k + i];
+			if (v >= 255)
 				++f.clipped;
 			else
-				f.unclipped.push_back(g[i]);
-	}
+			{
+				++f.unclipped;
+				++f.histogram[std::max(0, v)];
+			}
+		}
 	return f;
 }
 
-/** imputeClippedSide() where part of the fill is unclipped. */
-bool imputeClippedNoise(
-	const ClippedSideProfiles& s, const std::vector<std::optional<double>>& initial,
-	FillSamples f, std::vector<int>& g_profiles)
+bool imputeClippedNoise(std::vector<int>& g_profiles, const ClippedFill& f)
 {
-	if (f.unclipped.size() < 10 || f.clipped < 10) return false;
-	// 254.5 is the (1 - p_c) quantile, the unclipped median the
-	// (1 - p_c) / 2 one.
-	const double p_c = f.clippedFraction();
-	auto& u = f.unclipped;
-	std::nth_element(u.begin(), u.begin() + u.size() / 2, u.end());
-	const double median = u[u.size() / 2];
+	if (f.unclipped < 10 || f.clipped < 10) return false;
+	// 254.5 is the (1 - p_c) quantile of a censored normal, the unclipped
+	// median the (1 - p_c) / 2 one.
+	const double p_c = f.fraction();
+	int median = 0;
+	for (int seen = 0; median < 255; ++median)
+		if ((seen += f.histogram[median]) * 2 > f.unclipped) break;
 	const double z_c = inverseNormalCdf(1 - p_c), z_m = inverseNormalCdf(0.5 * (1 - p_c));
 	const double sigma = (254.5 - median) / (z_c - z_m);
 	if (!(sigma > 0.1) || !std::isfinite(sigma)) return false;
 	const double mu = 254.5 - sigma * z_c;
-	// E[v | v >= 254.5] = mu + sigma phi(z_c) / (1 - Phi(z_c)).
+	// E[v | v >= 254.5] = mu + sigma phi(z_c) / (1 - Phi(z_c)); every sample
+	// at the top is the fill's (the white margin, the frame and the code
+	// cells lie far below it when the fill is about at the top).
 	const int imputed =
 		static_cast<int>(std::lround(mu + sigma * phi(z_c) / std::max(1e-12, 1 - Phi(z_c))));
-	for (size_t j = 0; j < s.along.size(); ++j)
-	{
-		if (!initial[j]) continue;
-		int* g = g_profiles.data() + j * s.n;
-		for (int i = static_cast<int>(std::floor(*initial[j])) + 1; i < s.n; ++i)
-			if (g[i] >= 255) g[i] = imputed;
-	}
+	for (int& v : g_profiles)
+		if (v >= 255) v = imputed;
 	return true;
 }
-}  // namespace
 
 double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 {
@@ -296,10 +276,6 @@ bool imputeClippedSide(
 	// beyond the edge's midpoint gets the expectation of a sample above the
 	// clip, without a model of the edge (the few transition samples that
 	// clip are within a noise sigma of the fill).
-	const FillSamples fill = fillSamples(s, initial, g_profiles, fill_px);
-	if (fill.clipped + fill.unclipped.size() < kMinFillSamples) return false;
-	if (fill.clippedFraction() < kAllClippedFraction)
-		return imputeClippedNoise(s, initial, fill, g_profiles);
 	SideModel M{s, frame_px < kOuterModelPx};
 	// Where part of the fill is unclipped, G alone gives its level (the
 	// censored fit sees both sides of the clip). Where all of it clips, its

@@ -152,16 +152,25 @@ std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
 	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
 
-/** The profiles of one side, for imputeClippedSide(). Sample i of profile
+/** The profiles of one side, for imputeClippedSide(): sample i of profile
  * j lies at across coordinate base[j] + inward * i (i grows into the fill)
- * and along coordinate along[j]. */
+ * and along coordinate along[j] of \a image (rows: along is the row,
+ * across the column; otherwise the reverse). */
 struct ClippedSideProfiles
 {
+	const cv::Mat* image = nullptr;	 //!< CV_8UC3, BGR
+	bool rows = true;
 	int n = 0;	//!< samples per profile
 	int inward = 1;	 //!< +1 or -1
-	std::vector<uint8_t> bgr;  //!< profile j, sample i, channel c at (j n + i) 3 + c
-	std::vector<double> along;	//!< per profile [px]
-	std::vector<double> base;  //!< per profile [px]
+	std::vector<int> along;	 //!< per profile [px]
+	std::vector<int> base;	//!< per profile [px]
+	/** Channel c (0 B, 1 G, 2 R) of sample i of profile j. */
+	int sample(int j, int i, int c) const
+	{
+		const int a = base[j] + inward * i;
+		return rows ? image->ptr<uint8_t>(along[j])[3 * a + c]
+					: image->ptr<uint8_t>(a)[3 * along[j] + c];
+	}
 };
 
 /** Restores the G profiles of a side whose green fill clips at the
@@ -170,17 +179,14 @@ struct ClippedSideProfiles
  * peak and centroid outwards (the square looks larger): by 0.012 px where
  * only the noise of a fill at exactly 255 clips, 0.05 px at gains of
  * 1.1-1.6 within 2 m and up to 0.5 px on 4-5 px frames.
- * - Part of the fill band unclipped: its level and noise follow from where
- *   the clip cuts its samples' distribution and from their unclipped median
- *   (a censored normal); each clipped sample beyond the edge's midpoint gets
- *   the expectation of a sample above the clip.
- * - All of it clipped: a Gaussian-blurred, pixel-integrated step (with the
- *   frame's outer edge below 7 px) in B, G and R, the side's blur and levels
- *   shared and the edge a quadratic along the side, is fitted by maximum
- *   likelihood with the samples at 255 or 0 censored (Tobit); G's fill level
- *   comes from the unclipped channels' ratio; each clipped G sample on the
- *   fill side (and outside a thin frame) gets its expectation under that
- *   model and the clip. About 0.5 ms a side.
+ * Where part of the fill band is unclipped, imputeClippedNoise() does it
+ * before the edges are first located. Where all of it clips: a Gaussian-blurred, pixel-integrated step (with the
+ * frame's outer edge below 7 px) in B, G and R, the side's blur and levels
+ * shared and the edge a quadratic along the side, is fitted by maximum
+ * likelihood with the samples at 255 or 0 censored (Tobit); G's fill level
+ * comes from the unclipped channels' ratio; each clipped G sample on the
+ * fill side (and outside a thin frame) gets its expectation under that
+ * model and the clip. About 0.5 ms a side.
  * \a initial: each profile's edge estimate [profile index] (nullopt: none);
  * \a frame_px, \a fill_px: the black frame's and the green band's widths
  * across the side [px]; \a noise: the sensor's noise in G [grey levels]
@@ -193,6 +199,25 @@ struct ClippedSideProfiles
 bool imputeClippedSide(
 	const ClippedSideProfiles& side, const std::vector<std::optional<double>>& initial,
 	double frame_px, double fill_px, double noise, std::vector<int>& g_profiles);
+
+/** The G samples of a side's fill band (profile indices i0..i1 of each
+ * profile): how many are at the sensor's top, and the others. */
+struct ClippedFill
+{
+	int clipped = 0;  //!< samples at 255
+	int unclipped = 0;	//!< the others
+	std::array<int, 255> histogram{};  //!< of the others' values
+	int count() const { return clipped + unclipped; }
+	double fraction() const { return count() > 0 ? double(clipped) / count() : 0; }
+};
+ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1);
+
+/** Where part of a fill band is unclipped, only its noise clips: its level
+ * and noise follow from where the clip cuts its samples' distribution
+ * \a fill and from their unclipped median (a censored normal), and every
+ * sample at 255 of \a g_profiles gets the expectation of a sample above the
+ * clip. False (nothing changed) with under 10 samples on either side. */
+bool imputeClippedNoise(std::vector<int>& g_profiles, const ClippedFill& fill);
 
 /** The noise of G [grey levels] in the always-black centre code cell of the
  * quadrangle \a coarse (around its diagonals' intersection, the projected

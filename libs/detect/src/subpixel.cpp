@@ -9,6 +9,10 @@ namespace codemark::detect
 {
 namespace
 {
+/** The fill band counts as clipped throughout at this fraction of its
+ * samples at 255, and needs this many samples to say. */
+constexpr double kAllClippedFraction = 0.9;
+constexpr int kMinFillSamples = 20;
 /** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
@@ -242,9 +246,11 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
 		ClippedSideProfiles clip_side;
+		clip_side.image = &bgr;
+		clip_side.rows = along == 1;
 		clip_side.n = n;
 		clip_side.inward = inward;
-		int saturated = 0, clipped = 0, fill_clipped = 0, fill_samples = 0;
+		int saturated = 0, clipped = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
 			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
@@ -261,14 +267,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 					along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
 				g_prof.push_back(px[1]);
 				rb_prof.push_back(-(px[0] + px[2]));
-				clip_side.bgr.insert(clip_side.bgr.end(), px, px + 3);
-				if (i >= hi + 2)
-				{
-					fill_sum += px[1];
-					// Of the fill's samples (not a code cell's).
-					fill_clipped += px[1] >= 255;
-					fill_samples += px[1] >= 128;
-				}
+				if (i >= hi + 2) fill_sum += px[1];
 			}
 			if (fill_sum >= p.saturation_level * (n - hi - 2))
 			{
@@ -300,11 +299,24 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// estimator per side: mixing them would split the points into two
 		// populations.
 		const int half_count = static_cast<int>(pos.size()) / 2;
-		const bool side_saturated = saturated > half_count;
+		bool side_saturated = saturated > half_count;
 		const bool side_clipped = clipped > half_count;
+		// Where G clips, restore the clipped samples before the edges are
+		// read (imputeClippedNoise(), imputeClippedSide()): the clip cuts the
+		// bright half of the response. The fill band from the coarse line
+		// (within about a pixel of the edge): beyond the edge's blur, short
+		// of the code board.
+		const double fill_px = frame_px * fill_ratio / frame_ratio;
+		const ClippedFill band =
+			clippedFill(g_prof, n, half + 3, half + static_cast<int>(std::floor(fill_px - 3)));
+		const bool clips = p.model_clipping && band.count() >= kMinFillSamples &&
+						   band.fraction() > p.clipped_fraction;
+		const bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
+		// Part of the fill unclipped: only its noise clips.
+		if (clips && !all_clipped && imputeClippedNoise(g_prof, band)) side_saturated = false;
+		std::vector<std::optional<double>> edges(pos.size());
 		const auto locateAll = [&](bool saturated_path)
 		{
-			std::vector<std::optional<double>> edges(pos.size());
 			for (size_t j = 0; j < pos.size(); ++j)
 			{
 				const int* gp = g_prof.data() + j * n;
@@ -346,20 +358,13 @@ std::optional<RefinedQuad> refineQuadrangle(
 				}
 				edges[j] = e;
 			}
-			return edges;
 		};
-		std::vector<std::optional<double>> edges = locateAll(side_saturated);
-		// Where G clips (on the fill side of the search window, noise on a
-		// fill at the sensor's top included), restore the clipped samples
-		// from a model of the edge that knows the clip and read the edges
-		// again as on an unsaturated side.
-		const bool clips = p.model_clipping && fill_samples > 0 &&
-						   fill_clipped > p.clipped_fraction * fill_samples;
-		if (clips && noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
-		if (clips && imputeClippedSide(
-						 clip_side, edges, frame_px, frame_px * fill_ratio / frame_ratio, noise,
-						 g_prof))
-			edges = locateAll(false);
+		locateAll(side_saturated);
+		// All of the fill clipped: restore it from a model of the edge that
+		// knows the clip, then read the edges again as on an unsaturated side.
+		if (all_clipped && noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+		if (all_clipped && imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
+			locateAll(false);
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)
