@@ -100,9 +100,10 @@ int main(int argc, char** argv)
 			ro.loadFromConfigFile(ini, "render");
 		}
 		const LandmarkGeometry g = lm.geometry();
-		const detect::DetectorOptions dopt = detector_arg.getValue().empty()
-												 ? detect::DetectorOptions()
-												 : detect::DetectorOptions::load(detector_arg.getValue());
+		const detect::DetectorOptions dopt =
+			detector_arg.getValue().empty()
+				? detect::DetectorOptions()
+				: detect::DetectorOptions::load(detector_arg.getValue());
 		std::mt19937_64 rng(seed_arg.getValue());
 		std::uniform_real_distribution<double> U(0, 1);
 		std::vector<Sample> samples;

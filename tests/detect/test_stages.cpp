@@ -491,7 +491,7 @@ TEST(Subpixel, RefinedCornersOfACraftedLandmark)
 			for (int k = 0; k < 4; ++k)
 			{
 				EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), clipping ? 0.03 : 0.02)
-						<< "blur " << blur << " corner " << k << " clipping " << clipping;
+					<< "blur " << blur << " corner " << k << " clipping " << clipping;
 				EXPECT_LT(r->sides[k].rms_px, 0.05);
 				EXPECT_GT(r->sides[k].support, 60);
 			}

@@ -116,7 +116,8 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 			// max_view_angle_deg, 60 deg) a 1-2 px thin vertical frame makes
 			// the range 0.5-0.8% short (this loop's 71-deg sightings at
 			// 3.4-4.1 m): counted apart, not checked.
-			if (pose::viewAngle(truth.L) > filters::StepperOptions().max_view_angle_deg * M_PI / 180)
+			if (pose::viewAngle(truth.L) >
+				filters::StepperOptions().max_view_angle_deg * M_PI / 180)
 			{
 				++oblique;
 				oblique_z += (sg.L[0] - truth.L[0]) / sigma;
@@ -147,8 +148,8 @@ TEST(Annotate, SightingsMatchTheSimulatorsTruth)
 				std::sqrt(sum2[far][2] / count[far]));
 	if (oblique)
 		std::printf(
-			"beyond the filters' view angle: %d sightings, mean range error / sigma %+.2f\n", oblique,
-			oblique_z / oblique);
+			"beyond the filters' view angle: %d sightings, mean range error / sigma %+.2f\n",
+			oblique, oblique_z / oblique);
 	EXPECT_GE(checked, 40);
 	EXPECT_GE(within, 0.95 * checked) << within << " of " << checked << " ranges within 3 sigma";
 }

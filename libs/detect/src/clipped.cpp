@@ -237,8 +237,10 @@ bool imputeClippedNoise(std::vector<int>& g_profiles, const ClippedFill& f)
 double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 {
 	// The diagonals' intersection.
-	const Eigen::Vector3d d1 = Eigen::Vector3d(q[0].x(), q[0].y(), 1).cross(Eigen::Vector3d(q[2].x(), q[2].y(), 1));
-	const Eigen::Vector3d d2 = Eigen::Vector3d(q[1].x(), q[1].y(), 1).cross(Eigen::Vector3d(q[3].x(), q[3].y(), 1));
+	const Eigen::Vector3d d1 =
+		Eigen::Vector3d(q[0].x(), q[0].y(), 1).cross(Eigen::Vector3d(q[2].x(), q[2].y(), 1));
+	const Eigen::Vector3d d2 =
+		Eigen::Vector3d(q[1].x(), q[1].y(), 1).cross(Eigen::Vector3d(q[3].x(), q[3].y(), 1));
 	const Eigen::Vector3d c = d1.cross(d2);
 	if (std::abs(c.z()) < 1e-12) return 0;
 	const double cx = c.x() / c.z(), cy = c.y() / c.z();
@@ -247,7 +249,8 @@ double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 	// Half the cell, less the reach of a blur and of JPEG ringing.
 	const int h = static_cast<int>(std::floor(0.5 * cell_rel * side - 2.5));
 	if (h < 1) return 0;
-	const int x0 = static_cast<int>(std::lround(cx)) - h, y0 = static_cast<int>(std::lround(cy)) - h;
+	const int x0 = static_cast<int>(std::lround(cx)) - h,
+			  y0 = static_cast<int>(std::lround(cy)) - h;
 	if (x0 < 0 || y0 < 0 || x0 + 2 * h + 1 >= bgr.cols || y0 + 2 * h >= bgr.rows) return 0;
 	std::vector<double> diffs;
 	for (int y = y0; y <= y0 + 2 * h; ++y)
@@ -324,11 +327,12 @@ bool imputeClippedSide(
 	const auto windowOf = [&](int j, double e, double w) -> std::optional<Window>
 	{
 		const int fe = static_cast<int>(std::floor(e)), ce = static_cast<int>(std::ceil(e));
-		const int i0 = M.outer ? static_cast<int>(std::ceil(e - w + 0.5))
-							   : std::clamp(
-									 static_cast<int>(std::ceil(e - (frame_px - kClearPx))), fe - 4,
-									 fe - 1);
-		const int i1 = std::clamp(static_cast<int>(std::floor(e + fill_px - kClearPx)), ce + 1, ce + 4);
+		const int i0 =
+			M.outer ? static_cast<int>(std::ceil(e - w + 0.5))
+					: std::clamp(
+						  static_cast<int>(std::ceil(e - (frame_px - kClearPx))), fe - 4, fe - 1);
+		const int i1 =
+			std::clamp(static_cast<int>(std::floor(e + fill_px - kClearPx)), ce + 1, ce + 4);
 		if (i0 < 0 || i1 >= s.n) return std::nullopt;
 		return Window{j, i0, i1, M.tau(j)};
 	};
@@ -352,8 +356,11 @@ bool imputeClippedSide(
 		{
 			const double e = M.indexOf(w.j, SideModel::edgeAt(p, w.tau));
 			W += M.sample(w.j, w.i0, c);
-			lo += M.outer ? M.sample(w.j, std::max(w.i0, static_cast<int>(std::lround(e - 0.5 * frame_px))), c)
-						  : M.sample(w.j, w.i0, c);
+			lo +=
+				M.outer
+					? M.sample(
+						  w.j, std::max(w.i0, static_cast<int>(std::lround(e - 0.5 * frame_px))), c)
+					: M.sample(w.j, w.i0, c);
 			hi += M.sample(w.j, w.i1, c);
 		}
 		const double k = 1.0 / windows.size();
@@ -391,7 +398,8 @@ bool imputeClippedSide(
 			for (int i = w.i0; i <= w.i1; ++i)
 			{
 				const PixelStep in = pixelStep(i - e, sigma);
-				const PixelStep out = M.outer ? pixelStep(i - (e - width), sigma) : PixelStep{1, 0, 0};
+				const PixelStep out =
+					M.outer ? pixelStep(i - (e - width), sigma) : PixelStep{1, 0, 0};
 				for (int c = c_first; c <= c_last; ++c)
 				{
 					const double m = SideModel::value(q, c, in, out, g ? &J : nullptr);

@@ -180,22 +180,18 @@ struct ClippedSideProfiles
  * only the noise of a fill at exactly 255 clips, 0.05 px at gains of
  * 1.1-1.6 within 2 m and up to 0.5 px on 4-5 px frames.
  * Where part of the fill band is unclipped, imputeClippedNoise() does it
- * before the edges are first located. Where all of it clips: a Gaussian-blurred, pixel-integrated step (with the
- * frame's outer edge below 7 px) in B, G and R, the side's blur and levels
- * shared and the edge a quadratic along the side, is fitted by maximum
- * likelihood with the samples at 255 or 0 censored (Tobit); G's fill level
- * comes from the unclipped channels' ratio; each clipped G sample on the
- * fill side (and outside a thin frame) gets its expectation under that
- * model and the clip. About 0.5 ms a side.
- * \a initial: each profile's edge estimate [profile index] (nullopt: none);
- * \a frame_px, \a fill_px: the black frame's and the green band's widths
- * across the side [px]; \a noise: the sensor's noise in G [grey levels]
- * (centreCellNoise(); 0: unknown); \a g_profiles: side.along.size() x
- * side.n G samples, modified in place. Returns false, leaving them as they
- * were, when the side has too few edge points or fill samples, its frame is
- * under 3.5 px, the fit does not converge near them, the edge is too sharp
- * (one mixed sample a profile) to say where a clipped edge lies, or the
- * fit explains the samples worse than the noise (JPEG chroma). */
+ * before the edges are first located. Where all of it clips: a Gaussian-blurred, pixel-integrated
+ * step (with the frame's outer edge below 7 px) in B, G and R, the side's blur and levels shared
+ * and the edge a quadratic along the side, is fitted by maximum likelihood with the samples at 255
+ * or 0 censored (Tobit); G's fill level comes from the unclipped channels' ratio; each clipped G
+ * sample on the fill side (and outside a thin frame) gets its expectation under that model and the
+ * clip. About 0.5 ms a side. \a initial: each profile's edge estimate [profile index] (nullopt:
+ * none); \a frame_px, \a fill_px: the black frame's and the green band's widths across the side
+ * [px]; \a noise: the sensor's noise in G [grey levels] (centreCellNoise(); 0: unknown); \a
+ * g_profiles: side.along.size() x side.n G samples, modified in place. Returns false, leaving them
+ * as they were, when the side has too few edge points or fill samples, its frame is under 3.5 px,
+ * the fit does not converge near them, the edge is too sharp (one mixed sample a profile) to say
+ * where a clipped edge lies, or the fit explains the samples worse than the noise (JPEG chroma). */
 bool imputeClippedSide(
 	const ClippedSideProfiles& side, const std::vector<std::optional<double>>& initial,
 	double frame_px, double fill_px, double noise, std::vector<int>& g_profiles);

@@ -362,7 +362,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 		locateAll(side_saturated);
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
-		if (all_clipped && noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+		if (all_clipped && noise < 0)
+			noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
 		if (all_clipped && imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
 			locateAll(false);
 		std::vector<Eigen::Vector2d> pts;

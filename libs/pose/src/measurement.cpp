@@ -191,8 +191,8 @@ Measurement measure(
 	// range and phi2 use, far better known), and made the general path's
 	// mean NEES 2.66 against the band [2.72, 3.29] (test_pose_nees.cpp).
 	const double det = m.C_P.determinant();
-	const double sigma_corner = det > 0 ? std::sqrt(2 * std::pow(det, 0.25))
-										: std::sqrt(m.C_P(0, 0) + m.C_P(1, 1));
+	const double sigma_corner =
+		det > 0 ? std::sqrt(2 * std::pow(det, 0.25)) : std::sqrt(m.C_P(0, 0) + m.C_P(1, 1));
 	const GeneralPose g =
 		solveGeneralPose(corners, camera, geometry, sigma_corner, options.lm_max_iterations);
 	m.L = g.L;

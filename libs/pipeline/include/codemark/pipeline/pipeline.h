@@ -53,15 +53,15 @@ namespace codemark::pipeline
  * Re-run the calibration (scripts/bench-accuracy.sh) when the detector
  * changes. */
 constexpr double kDetectorSigmaXPx = 0.0175;  //!< constant part of sigma(x1), sigma(x2) [px]
-constexpr double kDetectorSigmaYPx = 0.0250;	 //!< constant part of sigma(y1), sigma(y2) [px]
+constexpr double kDetectorSigmaYPx = 0.0250;  //!< constant part of sigma(y1), sigma(y2) [px]
 constexpr double kDetectorGrowthXPx = 0.040;  //!< sigma(x) growth term at 30 px apparent width [px]
 constexpr double kDetectorGrowthYPx =
 	0.030;	//!< sigma(y) growth term at 30 px apparent height [px]
 constexpr double kDetectorSizeExponentX = 1.25;	 //!< exponent of the x growth
 constexpr double kDetectorSizeExponentY = 2.50;	 //!< exponent of the y growth
-constexpr double kDetectorCorrX12 = 0.25;	//!< corr(x1, x2), constant part
+constexpr double kDetectorCorrX12 = 0.25;  //!< corr(x1, x2), constant part
 constexpr double kDetectorCorrGrowthX12 = -0.40;  //!< corr(x1, x2), growing part
-constexpr double kDetectorCorrY12 = -0.15;  //!< corr(y1, y2), constant part
+constexpr double kDetectorCorrY12 = -0.15;	//!< corr(y1, y2), constant part
 constexpr double kDetectorCorrGrowthY12 = 0.20;	 //!< corr(y1, y2), growing part
 
 /** The pose options codemark's detector is calibrated for (see above). */
