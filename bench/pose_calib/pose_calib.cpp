@@ -23,6 +23,7 @@
 #include <fstream>
 #include <iostream>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 using namespace codemark;
@@ -96,7 +97,13 @@ int main(int argc, char** argv)
 		if (realistic_arg.getValue()) ro = sim::DatasetOptions::realisticRender();
 		if (!render_arg.getValue().empty())
 		{
-			const mrpt::config::CConfigFile ini(render_arg.getValue());
+			// MRPT reads a missing file as an empty one: say so instead.
+			const std::string& path = render_arg.getValue();
+			if (!std::ifstream(path).good())
+				throw std::runtime_error(path + ": cannot open the render options file");
+			const mrpt::config::CConfigFile ini(path);
+			if (!ini.sectionExists("render"))
+				throw std::runtime_error(path + ": no [render] section");
 			ro.loadFromConfigFile(ini, "render");
 		}
 		const LandmarkGeometry g = lm.geometry();

@@ -21,17 +21,15 @@ constexpr int kG = 1;  // BGR
 // Parameters of a side: its inner edge's across coordinate as a quadratic
 // in the normalised along coordinate (a lens bends a line a little), the
 // blur, the black frame's width (linear along the side: perspective), and
-// per channel the levels outside the frame, in it and in the fill.
-constexpr int kE0 = 0, kSigma = 3, kW0 = 4, kW1 = 5, kLevel = 6;
-// The black frame and the white margin are neutral (black ink, white
-// paper: equal in B, G and R after white balance), which a thin frame
-// needs: its own samples barely reach the black level. The fill is not.
-constexpr int kParams = kLevel + 2 + kChannels;
+// the levels outside the frame and in it (the black frame and the white
+// margin are neutral, black ink and white paper equal in B, G and R after
+// white balance, which a thin frame needs: its own samples barely reach the
+// black level), and per channel the fill's (which is not neutral).
+constexpr int kE0 = 0, kSigma = 3, kW0 = 4, kW1 = 5, kOutside = 6, kFrame = 7, kFill = 8;
+constexpr int kParams = kFill + kChannels;
 using Vec = Eigen::Matrix<double, kParams, 1>;
 using Mat = Eigen::Matrix<double, kParams, kParams>;
-int outsideOf(int) { return kLevel; }
-int frameOf(int) { return kLevel + 1; }
-int fillOf(int c) { return kLevel + 2 + c; }
+int fillOf(int c) { return kFill + c; }
 
 /** Below this frame width [px] the frame's samples never reach its black
  * level, and the levels, the blur and the two edges trade off: no model. */
@@ -162,24 +160,21 @@ struct SideModel
 	 * same in every channel). */
 	static double value(const Vec& p, int c, const PixelStep& in, const PixelStep& out, Vec* J)
 	{
-		const double W = p[outsideOf(c)], lo = p[frameOf(c)], hi = p[fillOf(c)];
+		const double W = p[kOutside], lo = p[kFrame], hi = p[fillOf(c)];
 		if (J)
 		{
 			J->setZero();
 			(*J)[kE0] = -(hi - lo) * in.d_x - (lo - W) * out.d_x;
 			(*J)[kSigma] = (lo - W) * out.d_sigma + (hi - lo) * in.d_sigma;
 			(*J)[kW0] = (lo - W) * out.d_x;
-			(*J)[outsideOf(c)] = 1 - out.value;
-			(*J)[frameOf(c)] = out.value - in.value;
+			(*J)[kOutside] = 1 - out.value;
+			(*J)[kFrame] = out.value - in.value;
 			(*J)[fillOf(c)] = in.value;
 		}
 		return W + (lo - W) * out.value + (hi - lo) * in.value;
 	}
 };
-}  // namespace
 
-namespace
-{
 /** z with Phi(z) = q, 0 < q < 1 (Newton from the logistic guess). */
 double inverseNormalCdf(double q)
 {
@@ -273,22 +268,11 @@ bool imputeClippedSide(
 	if (np == 0 || static_cast<int>(initial.size()) != np || s.n < 5 ||
 		g_profiles.size() != size_t(np) * s.n || frame_px < kMinFramePx)
 		return false;
-	// Part of the fill unclipped: only its noise clips. Its level and noise
-	// follow from where the clip cuts the samples' distribution and from
-	// their unclipped median (a censored normal), and every clipped sample
-	// beyond the edge's midpoint gets the expectation of a sample above the
-	// clip, without a model of the edge (the few transition samples that
-	// clip are within a noise sigma of the fill).
+	// All of the fill clips: G's fill level would come from the shape of
+	// the few unclipped samples of its edge, which a model's shape error
+	// (about 1% of the step) moves by several percent. B and R (unclipped)
+	// join the fit, and give that level through their ratio below.
 	SideModel M{s, frame_px < kOuterModelPx};
-	// Where part of the fill is unclipped, G alone gives its level (the
-	// censored fit sees both sides of the clip). Where all of it clips, its
-	// level would come from the shape of the few unclipped samples of the
-	// edge, which a model's shape error (about 1% of the step) moves by
-	// several percent: B and R (unclipped) then join the fit, and give the
-	// level through their ratio below. Not before: a JPEG's subsampled
-	// chroma or a camera's demosaicing make them a blurred, shifted copy.
-	const bool rb = true;
-	const int c_first = 0, c_last = 2;
 	const auto [tmin, tmax] = std::minmax_element(s.along.begin(), s.along.end());
 	M.tmid = 0.5 * (*tmin + *tmax);
 	M.thalf = std::max(1.0, 0.5 * (*tmax - *tmin));
@@ -364,8 +348,8 @@ bool imputeClippedSide(
 			hi += M.sample(w.j, w.i1, c);
 		}
 		const double k = 1.0 / windows.size();
-		p[outsideOf(c)] += W * k / kChannels;
-		p[frameOf(c)] += lo * k / kChannels;
+		p[kOutside] += W * k / kChannels;
+		p[kFrame] += lo * k / kChannels;
 		p[fillOf(c)] = hi * k >= 254 ? 300 : hi * k;
 	}
 	p[kSigma] = 0.8;
@@ -373,14 +357,7 @@ bool imputeClippedSide(
 	// Parameters the data cannot move: without the outer edge, its width
 	// and the outside levels.
 	std::vector<int> fixed;
-	for (int c = 0; c < kChannels; ++c)
-		if (c < c_first || c > c_last) fixed.push_back(fillOf(c));
-	if (!M.outer)
-	{
-		fixed.push_back(kW0);
-		fixed.push_back(kW1);
-		for (int c = 0; c < kChannels; ++c) fixed.push_back(outsideOf(c));
-	}
+	if (!M.outer) fixed = {kW0, kW1, kOutside};
 	// The side's negative log-likelihood, its gradient and Gauss-Newton
 	// Hessian; sn the pixel noise; the sum of squares of the unclipped
 	// residuals through ss, nss.
@@ -400,7 +377,7 @@ bool imputeClippedSide(
 				const PixelStep in = pixelStep(i - e, sigma);
 				const PixelStep out =
 					M.outer ? pixelStep(i - (e - width), sigma) : PixelStep{1, 0, 0};
-				for (int c = c_first; c <= c_last; ++c)
+				for (int c = 0; c < kChannels; ++c)
 				{
 					const double m = SideModel::value(q, c, in, out, g ? &J : nullptr);
 					const int v = M.sample(w.j, i, c);
@@ -440,7 +417,7 @@ bool imputeClippedSide(
 			gg[k] = 0;
 		};
 		for (const int k : fixed) freeze(k);
-		for (int k = kLevel; k < kParams; ++k)
+		for (int k = kOutside; k < kParams; ++k)
 			if (q[k] <= 0 && g[k] > 0) freeze(k);
 	};
 	const auto solve = [&](Vec q, double sn, int iterations)
@@ -461,7 +438,7 @@ bool imputeClippedSide(
 			cand[kW0] = std::max(0.5, cand[kW0]);
 			// Light is never negative: a fill at the sensor's floor (R and B
 			// of a pure green) must not drift below it.
-			for (int k = kLevel; k < kParams; ++k) cand[k] = std::max(0.0, cand[k]);
+			for (int k = kOutside; k < kParams; ++k) cand[k] = std::max(0.0, cand[k]);
 			const double nll_c = evaluate(cand, sn, &g_c, &H_c, nullptr, nullptr);
 			if (nll_c < nll)
 			{
@@ -477,15 +454,14 @@ bool imputeClippedSide(
 		}
 		return q;
 	};
-	// Fit with the measured noise (or a nominal one), estimate the noise
-	// from the unclipped residuals, and refine with it.
+	// Fit with a nominal noise, estimate the noise from the unclipped
+	// residuals, and refine with it.
 	constexpr double kNominalNoise = 2.0;
-	const double sn0 = kNominalNoise;
-	p = solve(p, sn0, 20);
+	p = solve(p, kNominalNoise, 20);
 	double ss = 0;
 	int nss = 0;
-	evaluate(p, sn0, nullptr, nullptr, &ss, &nss);
-	const double sn = nss > 10 ? std::clamp(std::sqrt(ss / nss), 0.5, 20.0) : sn0;
+	evaluate(p, kNominalNoise, nullptr, nullptr, &ss, &nss);
+	const double sn = nss > 10 ? std::clamp(std::sqrt(ss / nss), 0.5, 20.0) : kNominalNoise;
 	p = solve(p, sn, 5);
 	// The clip leaves G's fill level to the shape of the few unclipped
 	// samples of its edge, where the model's shape error (about 1% of the
@@ -495,27 +471,29 @@ bool imputeClippedSide(
 	// of sums of (G - frame level) and F over the unclipped ones (chosen by
 	// the model's values, not the noisy samples). Then fit again with it.
 	{
-		const double lo_rb = p[frameOf(0)] + p[frameOf(2)];
+		const double lo_rb = 2 * p[kFrame];
 		const double step_rb = lo_rb - p[fillOf(0)] - p[fillOf(2)];
 		double num = 0, den = 0;
-		if (rb && step_rb >= kMinRbStep)
+		if (step_rb >= kMinRbStep)
 			for (const Window& w : windows)
 			{
 				const double e = M.indexOf(w.j, SideModel::edgeAt(p, w.tau));
 				const double width = SideModel::widthAt(p, w.tau);
 				for (int i = std::max(w.i0, static_cast<int>(std::ceil(e - 1.5))); i <= w.i1; ++i)
 				{
-					const double F_model = pixelStep(i - e, p[kSigma]).value;
-					if (F_model < 0.1 || F_model > 0.9 ||
-						M.value(p, kG, i, e, width, nullptr) > kUnclippedG)
+					const PixelStep in = pixelStep(i - e, p[kSigma]);
+					const PixelStep out =
+						M.outer ? pixelStep(i - (e - width), p[kSigma]) : PixelStep{1, 0, 0};
+					if (in.value < 0.1 || in.value > 0.9 ||
+						SideModel::value(p, kG, in, out, nullptr) > kUnclippedG)
 						continue;
-					num += M.sample(w.j, i, kG) - p[frameOf(kG)];
+					num += M.sample(w.j, i, kG) - p[kFrame];
 					den += (lo_rb - M.sample(w.j, i, 0) - M.sample(w.j, i, 2)) / step_rb;
 				}
 			}
 		if (den > kMinRatioSamples * 0.5)
 		{
-			p[fillOf(kG)] = p[frameOf(kG)] + num / den;
+			p[fillOf(kG)] = p[kFrame] + num / den;
 			fixed.push_back(fillOf(kG));
 			p = solve(p, sn, 10);
 		}
@@ -526,8 +504,7 @@ bool imputeClippedSide(
 	// with the model, which is then not used.
 	const bool misfit = noise > 0 && sn > kMisfitFactor * std::max(0.5, noise) + kMisfitFloor;
 	if (!p.allFinite() || std::abs(p[kE0] - e0_initial) > 1.5 || p[kSigma] < kMinSigmaPx ||
-		p[kSigma] > kMaxSigmaPx || p[outsideOf(0)] > kMaxLevel || p[fillOf(kG)] > kMaxLevel ||
-		misfit)
+		p[kSigma] > kMaxSigmaPx || p[kOutside] > kMaxLevel || p[fillOf(kG)] > kMaxLevel || misfit)
 		return false;
 	{
 		Vec g, gg;

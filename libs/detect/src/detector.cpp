@@ -57,6 +57,12 @@ DetectionResult detect(
 	res.counts.rois = static_cast<int>(candidates.size());
 	tm.components_us = microsSince(t);
 
+	// The landmark's proportions over the reference square's side: the black
+	// frame's width, and the green band's between it and the code board.
+	const double frame_ratio =
+		(geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
+	const double fill_ratio =
+		(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m);
 	for (const Candidate& cand : candidates)
 	{
 		// 4. Gradients of G in the ROI: edgels with polarity, edgel domains.
@@ -66,8 +72,7 @@ DetectionResult detect(
 
 		// 5. Segment selection: size, polarity, slimness, relative length.
 		const auto sides = selectSegments(
-			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr,
-			(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m));
+			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr, fill_ratio);
 		tm.segments_us += microsSince(t);
 		if (debug) dbg.edgels.push_back(std::move(edgels));
 		if (!sides) continue;
@@ -79,10 +84,6 @@ DetectionResult detect(
 		++res.counts.quads;
 
 		// 7. Sub-pixel edges, a line per side, corners.
-		const double frame_ratio =
-			(geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
-		const double fill_ratio =
-			(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m);
 		auto refined =
 			refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio);
 		tm.subpixel_us += microsSince(t);

@@ -245,11 +245,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int n = 2 * half + 1;
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
-		ClippedSideProfiles clip_side;
-		clip_side.image = &bgr;
-		clip_side.rows = along == 1;
-		clip_side.n = n;
-		clip_side.inward = inward;
 		int saturated = 0, clipped = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
@@ -282,8 +277,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 			}
 			pos.push_back(s);
 			origin.push_back(c0);
-			clip_side.along.push_back(s);
-			clip_side.base.push_back(c0 - inward * half);
 		}
 		// G saturates on bright fills (the sensor clips at 255), which cuts
 		// the response on the bright side and pulls its centroid towards the
@@ -362,10 +355,19 @@ std::optional<RefinedQuad> refineQuadrangle(
 		locateAll(side_saturated);
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
-		if (all_clipped && noise < 0)
-			noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
-		if (all_clipped && imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
-			locateAll(false);
+		if (all_clipped)
+		{
+			if (noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+			ClippedSideProfiles clip_side;
+			clip_side.image = &bgr;
+			clip_side.rows = along == 1;
+			clip_side.n = n;
+			clip_side.inward = inward;
+			clip_side.along = pos;
+			for (const int c0 : origin) clip_side.base.push_back(c0 - inward * half);
+			if (imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
+				locateAll(false);
+		}
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)

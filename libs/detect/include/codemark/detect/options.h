@@ -159,10 +159,10 @@ struct SubpixelParams
 	 * each edge move outwards by 0.012 px where only a fill's noise clips,
 	 * 0.05 px at gains of 1.1-1.6 and up to 0.5 px on thin frames. */
 	bool model_clipping = true;
-	/** ... on sides where more than this fraction of the fill's samples
-	 * beyond the search window (G >= 128: not a code cell) are at 255. A
-	 * fill at exactly the top clips half of them through its noise; a JPEG's
-	 * ringing next to an unclipped fill a few. */
+	/** ... on sides where more than this fraction of the fill band's samples
+	 * (from the coarse line, beyond the edge's blur and short of the code
+	 * board) are at 255. A fill at exactly the top clips half of them through
+	 * its noise; a JPEG's ringing next to an unclipped fill a few. */
 	double clipped_fraction = 0.25;
 	/** Where the black frame is narrower than this across a side [px], its
 	 * outer edge overlaps the inner edge's response: the edge is then taken
