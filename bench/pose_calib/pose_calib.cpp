@@ -257,6 +257,29 @@ int main(int argc, char** argv)
 			"%.3f, corr_y12 %+.3f\n",
 			fy.floor, fy.growth, fy.exponent, cyy / samples.size(),
 			c12y / samples.size() / (cyy / samples.size()));
+		// The corners' four other numbers (PoseOptions::corner_midpoint_ratio,
+		// corner_tilt_ratio; pose::cornerCovarianceFromPrimary()): each
+		// vertical edge's midpoint height m = (v_top + v_bottom) / 2 against
+		// sigma_y, its tilt t = (u_top - u_bottom) / 2 against sigma_x, RMS of
+		// the normalised errors.
+		double zm = 0, zt = 0;
+		for (const auto& s : samples)
+		{
+			const auto var = [&](const Fit& f, double size)
+			{
+				const double g = f.growth * std::pow(ref / size, f.exponent);
+				return f.floor * f.floor + g * g;
+			};
+			const double vx = var(fx, s.width_px), vy = var(fy, s.side_px);
+			const auto& e = s.e_corner;	 // TL.u TL.v TR.u TR.v BR.u BR.v BL.u BL.v
+			const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
+			const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
+			zm += (m1 * m1 + m2 * m2) / (2 * vy);
+			zt += (t1 * t1 + t2 * t2) / (2 * vx);
+		}
+		std::printf(
+			"  corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n", std::sqrt(zm / samples.size()),
+			std::sqrt(zt / samples.size()));
 		std::printf(
 			"%-9s %5s %7s | %7s %7s | %7s %7s %7s %7s | %6s %6s %6s\n", "band", "n", "side",
 			"rms_u", "rms_v", "sd_x1", "sd_y1", "sd_x2", "sd_y2", "r_y1y2", "r_x1x2", "r_uTB");

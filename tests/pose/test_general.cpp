@@ -1,6 +1,7 @@
 // The general 6-DoF path: the exactly-180-degree case that OpenCV 4.6's
 // SOLVEPNP_IPPE_SQUARE gets wrong, agreement with the closed form for level
 // cameras, tilted cameras with lens distortion, ambiguity and covariance.
+#include <codemark/landmark/primary.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/pose/general.h>
 #include <codemark/pose/measurement.h>
@@ -249,6 +250,82 @@ TEST(General, CovarianceMatchesMonteCarlo)
 	const Eigen::Matrix3d CL = C.topLeftCorner<3, 3>(), CR = C.bottomRightCorner<3, 3>();
 	EXPECT_LT((CL - ref.C_L).norm() / ref.C_L.norm(), 0.15);
 	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.15);
+}
+
+TEST(General, CornerCovarianceFromPrimaryReproducesCP)
+{
+	// dP/dcorners (central differences of primaryMeasurement, raw pixels,
+	// with lens distortion and fx != fy) maps the lifted corner covariance
+	// back onto C_P exactly; the lifted covariance is positive definite.
+	CameraModel cam = distortedCamera();
+	const LandmarkGeometry g;
+	for (const auto& [d, a, phi1] :
+		 {std::array<double, 3>{1.2, 0.3, 0.1}, {3.5, -0.9, -0.05}, {0.8, 0.0, 0.0}})
+	{
+		const auto corners = projectCorners(cameraAt(d, a, 0.15, phi1), cam, g);
+		Eigen::Matrix4d C_P;
+		C_P << 4, 0, -1.5, 0, 0, 2, 0, 0.6, -1.5, 0, 4, 0, 0, 0.6, 0, 2;
+		C_P *= 1e-4;
+		const CornerCovariance C = cornerCovarianceFromPrimary(corners, cam, C_P);
+		Eigen::Matrix<double, 4, 8> J;
+		for (int k = 0; k < 8; ++k)
+		{
+			auto p = corners, m = corners;
+			p[k / 2][k % 2] += 1e-5;
+			m[k / 2][k % 2] -= 1e-5;
+			J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
+		}
+		const Eigen::Matrix4d back = J * C * J.transpose();
+		EXPECT_LT((back - C_P).norm(), 1e-6 * C_P.norm()) << "d " << d;
+		EXPECT_LT((C - C.transpose()).norm(), 1e-12 * C.norm());
+		EXPECT_GT(Eigen::SelfAdjointEigenSolver<CornerCovariance>(C).eigenvalues().minCoeff(), 0);
+	}
+}
+
+TEST(General, CorrelatedCornerCovarianceMatchesMonteCarlo)
+{
+	// Corners drawn from a correlated covariance (x1, x2 anti-correlated as
+	// the detector's edges are): the sandwich covariance of the unweighted
+	// LM against the samples.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const CPose3D truth = cameraAt(2.0, 0.6, 0.1, 0.0);
+	const auto corners = projectCorners(truth, cam, g);
+	Eigen::Matrix4d C_P;
+	C_P << 1, 0, -0.6, 0, 0, 1.5, 0, 0.3, -0.6, 0, 1, 0, 0, 0.3, 0, 1.5;
+	C_P *= 0.05 * 0.05;
+	const CornerCovariance Cc = cornerCovarianceFromPrimary(corners, cam, C_P);
+	const GeneralPose ref = solveGeneralPose(corners, cam, g, Cc);
+	const CornerCovariance Lc = Cc.llt().matrixL();
+	std::mt19937 rng(17);
+	std::normal_distribution<double> n(0, 1);
+	const int N = 3000;
+	std::vector<Eigen::Matrix<double, 6, 1>> v;
+	for (int i = 0; i < N; ++i)
+	{
+		Eigen::Matrix<double, 8, 1> z;
+		for (int k = 0; k < 8; ++k) z[k] = n(rng);
+		const Eigen::Matrix<double, 8, 1> e = Lc * z;
+		auto c = corners;
+		for (int k = 0; k < 4; ++k) c[k] += e.segment<2>(2 * k);
+		const GeneralPose gp = solveGeneralPose(c, cam, g, Cc);
+		Eigen::Matrix<double, 6, 1> x;
+		x << gp.L - ref.L, gp.pose_in_landmark - ref.pose_in_landmark;
+		x[2] = wrapToPi(x[2]);
+		x[5] = wrapToPi(x[5]);
+		v.push_back(x);
+	}
+	Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+	for (const auto& x : v) mean += x / N;
+	Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+	for (const auto& x : v) C += (x - mean) * (x - mean).transpose() / (N - 1);
+	const Eigen::Matrix3d CL = C.topLeftCorner<3, 3>(), CR = C.bottomRightCorner<3, 3>();
+	EXPECT_LT((CL - ref.C_L).norm() / ref.C_L.norm(), 0.1);
+	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.1);
+	// The isotropic sigma of the same determinant predicts another C_R.
+	const double s_iso = std::sqrt(2 * std::pow(C_P.determinant(), 0.25));
+	const GeneralPose iso = solveGeneralPose(corners, cam, g, s_iso);
+	EXPECT_GT((iso.C_R - ref.C_R).norm() / ref.C_R.norm(), 0.2);
 }
 
 TEST(General, AmbiguityAndBothSolutions)

@@ -119,6 +119,70 @@ GeneralPose solveGeneralPose(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, double corner_sigma_px, int lm_max_iterations)
 {
+	return solveGeneralPose(
+		corners, camera, geometry,
+		CornerCovariance(corner_sigma_px * corner_sigma_px * CornerCovariance::Identity()),
+		lm_max_iterations);
+}
+
+CornerCovariance cornerCovarianceFromPrimary(
+	const std::array<Eigen::Vector2d, 4>& raw, const CameraModel& cam, const Eigen::Matrix4d& C_P,
+	double midpoint_ratio, double tilt_ratio)
+{
+	// T: ideal corners -> [x1 y1 x2 y2 m1 m2 t1 t2]; its first four rows are
+	// dP/dcorners of primaryMeasurementFromIdeal() (x1, x2 the means of the
+	// edges' x, y1, y2 their half-lengths in fx units).
+	std::array<Eigen::Vector2d, 4> ideal;
+	for (int k = 0; k < 4; ++k) ideal[k] = cam.undistortPixel(raw[k]);
+	const double sy = cam.fx() / cam.fy();
+	CornerCovariance T = CornerCovariance::Zero();
+	for (const auto& [top, bottom, e] : {std::array<int, 3>{0, 3, 0}, {1, 2, 1}})
+	{
+		const int top_u = 2 * top, bottom_u = 2 * bottom;
+		T(2 * e, top_u) = T(2 * e, bottom_u) = 0.5;	 // x_e
+		const Eigen::Vector2d d(
+			ideal[top].x() - ideal[bottom].x(), (ideal[top].y() - ideal[bottom].y()) * sy);
+		const double n = std::max(1e-9, d.norm());
+		const Eigen::Vector2d g(0.5 * d.x() / n, 0.5 * d.y() / n * sy);
+		T.block<1, 2>(2 * e + 1, top_u) = g.transpose();  // y_e
+		T.block<1, 2>(2 * e + 1, bottom_u) = -g.transpose();
+		T(4 + e, top_u + 1) = T(4 + e, bottom_u + 1) = 0.5 * sy;  // m_e
+		T(6 + e, top_u) = 0.5;	// t_e
+		T(6 + e, bottom_u) = -0.5;
+	}
+	CornerCovariance Cc = CornerCovariance::Zero();
+	Cc.topLeftCorner<4, 4>() = C_P;
+	for (int e = 0; e < 2; ++e)
+	{
+		Cc(4 + e, 4 + e) = midpoint_ratio * midpoint_ratio * C_P(2 * e + 1, 2 * e + 1);
+		Cc(6 + e, 6 + e) = tilt_ratio * tilt_ratio * C_P(2 * e, 2 * e);
+	}
+	const CornerCovariance Ti = T.inverse();
+	const CornerCovariance C = Ti * Cc * Ti.transpose();
+	// Ideal -> raw pixels: the distortion's Jacobian per corner, by central
+	// differences of CameraModel::distortNormalized (identity without
+	// distortion).
+	CornerCovariance D = CornerCovariance::Zero();
+	for (int k = 0; k < 4; ++k)
+		for (int a = 0; a < 2; ++a)
+		{
+			const double h = 1e-4;
+			Eigen::Vector2d xp = ideal[k], xm = ideal[k];
+			xp[a] += h;
+			xm[a] -= h;
+			const auto toRaw = [&](const Eigen::Vector2d& x) {
+				return cam.distortNormalized(
+					{(x.x() - cam.cx()) / cam.fx(), (x.y() - cam.cy()) / cam.fy()});
+			};
+			D.block<2, 1>(2 * k, 2 * k + a) = (toRaw(xp) - toRaw(xm)) / (2 * h);
+		}
+	return D * C * D.transpose();
+}
+
+GeneralPose solveGeneralPose(
+	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
+	const LandmarkGeometry& geometry, const CornerCovariance& corner_cov, int lm_max_iterations)
+{
 	const cv::Mat K = cameraMatrix(camera), dist = distCoeffs(camera);
 	std::vector<cv::Point3d> obj;
 	for (const auto& m : modelPoints(geometry)) obj.emplace_back(m.x(), m.y(), m.z());
@@ -172,8 +236,10 @@ GeneralPose solveGeneralPose(
 		s.rvec_tvec = p;
 		s.landmark_T_camera = landmarkTCameraFromRvecTvec(p);
 		s.rms_px = pr.rms;
-		const Eigen::Matrix<double, 6, 6> JtJ = pr.J.transpose() * pr.J;
-		s.cov = corner_sigma_px * corner_sigma_px * JtJ.inverse();
+		// The LM refinement is unweighted: its covariance is the sandwich
+		// (J^T J)^-1 J^T C_c J (J^T J)^-1.
+		const Eigen::Matrix<double, 6, 6> JtJi = (pr.J.transpose() * pr.J).inverse();
+		s.cov = JtJi * pr.J.transpose() * corner_cov * pr.J * JtJi;
 		// Only the landmark's front side is printed: a camera behind it is no solution.
 		if (s.landmark_T_camera.x() > 0) sols.push_back(s);
 	}

@@ -63,6 +63,12 @@ constexpr double kDetectorCorrX12 = 0.25;  //!< corr(x1, x2), constant part
 constexpr double kDetectorCorrGrowthX12 = -0.40;  //!< corr(x1, x2), growing part
 constexpr double kDetectorCorrY12 = -0.15;	//!< corr(y1, y2), constant part
 constexpr double kDetectorCorrGrowthY12 = 0.20;	 //!< corr(y1, y2), growing part
+/** The corners' other four numbers (general path,
+ * pose::cornerCovarianceFromPrimary(); the same fit): an edge's midpoint
+ * height errs 0.78 sigma(y_i), its tilt 0.24 sigma(x_i): the detector's
+ * edge errors are mostly shifts of whole lines, not rotations. */
+constexpr double kDetectorCornerMidpointRatio = 0.78;
+constexpr double kDetectorCornerTiltRatio = 0.24;  //!< see kDetectorCornerMidpointRatio
 
 /** The pose options codemark's detector is calibrated for (see above). */
 inline pose::PoseOptions detectorCalibratedPoseOptions()
@@ -79,6 +85,8 @@ inline pose::PoseOptions detectorCalibratedPoseOptions()
 	o.corr_growth_x12 = kDetectorCorrGrowthX12;
 	o.corr_y12 = kDetectorCorrY12;
 	o.corr_growth_y12 = kDetectorCorrGrowthY12;
+	o.corner_midpoint_ratio = kDetectorCornerMidpointRatio;
+	o.corner_tilt_ratio = kDetectorCornerTiltRatio;
 	o.second_order_pose_covariance = true;
 	return o;
 }
@@ -89,10 +97,10 @@ inline pose::PoseOptions detectorCalibratedPoseOptions()
  * map's grid, 2913 detections) fits x1, x2 at 0.0025 px growing as (30 px /
  * width)^1.5 with 0.040 px at 30 px, corr(x1, x2) +0.40 / -0.30, and y1, y2
  * at 0.0050 px growing as (30 px / height)^1.75 with 0.040 px, corr(y1, y2)
- * -0.20 / -0.35: without the wall's texture and the light gradient the
- * detector is 3-7x better at close range, as good beyond 3 m. Use it for
- * images of that kind (codemark-accuracy-map --calibration plain); the
- * shipped default is the realistic one above. */
+ * -0.20 / -0.35, corner midpoint and tilt ratios 0.93 and 0.32: without the wall's texture and the
+ * light gradient the detector is 3-7x better at close range, as good beyond 3 m. Use it for images
+ * of that kind (codemark-accuracy-map --calibration plain); the shipped default is the realistic
+ * one above. */
 inline pose::PoseOptions plainBackgroundPoseOptions()
 {
 	pose::PoseOptions o = detectorCalibratedPoseOptions();
@@ -106,6 +114,8 @@ inline pose::PoseOptions plainBackgroundPoseOptions()
 	o.corr_growth_x12 = -0.30;
 	o.corr_y12 = -0.20;
 	o.corr_growth_y12 = -0.35;
+	o.corner_midpoint_ratio = 0.93;
+	o.corner_tilt_ratio = 0.32;
 	return o;
 }
 

@@ -33,8 +33,10 @@ struct PnPSolution
 	 * (identity rotation for a level camera squarely facing the landmark). */
 	Eigen::Matrix<double, 6, 1> rvec_tvec = Eigen::Matrix<double, 6, 1>::Zero();
 	double rms_px = 0;	//!< RMS reprojection error over the 8 corner coordinates [px]
-	/** Covariance of rvec_tvec from the corner noise: sigma^2 (J^T J)^-1, J the
-	 * 8x6 Jacobian of the raw-pixel projections (cv::projectPoints). */
+	/** Covariance of rvec_tvec from the corner noise C_c (8x8):
+	 * (J^T J)^-1 J^T C_c J (J^T J)^-1 (the unweighted LM estimate's
+	 * covariance; sigma^2 (J^T J)^-1 for isotropic noise), J the 8x6
+	 * Jacobian of the raw-pixel projections (cv::projectPoints). */
 	Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
@@ -63,6 +65,34 @@ struct GeneralPose
 GeneralPose solveGeneralPose(
 	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
 	const LandmarkGeometry& geometry, double corner_sigma_px, int lm_max_iterations = 30);
+
+/** The covariance of the 8 raw corner coordinates, order TL.u TL.v TR.u ...
+ * BL.v [px^2]. */
+using CornerCovariance = Eigen::Matrix<double, 8, 8>;
+
+/** As above with correlated corner noise \a corner_cov (raw px^2, positive
+ * definite). */
+GeneralPose solveGeneralPose(
+	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
+	const LandmarkGeometry& geometry, const CornerCovariance& corner_cov,
+	int lm_max_iterations = 30);
+
+/** A corner covariance whose image under P's Jacobian (P =
+ * primaryMeasurement(), a function of the 8 coordinates) is exactly \a C_P.
+ * The 8 coordinates are mapped one-to-one onto P and four more numbers: the
+ * vertical position of each vertical edge's midpoint (m1, m2, in fx units)
+ * and each edge's tilt (t1, t2: half the x difference of its ends). These
+ * get independent variances \a midpoint_ratio^2 var(y_i) and \a tilt_ratio^2
+ * var(x_i); ratios of 1 are independent corners of equal noise (the spec's
+ * isotropic model), codemark's detector measures 0.8 and 0.25 (its edge
+ * errors are mostly shifts of whole lines: pipeline.h). Mapped to raw
+ * pixels through the distortion's Jacobian. It lets the general path use
+ * the closed form's correlated edge noise, which one isotropic corner sigma
+ * cannot carry (a common shift of x1 and x2 is far less certain than their
+ * difference, which range and phi2 use). */
+CornerCovariance cornerCovarianceFromPrimary(
+	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
+	const Eigen::Matrix4d& C_P, double midpoint_ratio = 1.0, double tilt_ratio = 1.0);
 
 /** The landmark_T_camera of OpenCV's (rvec, tvec) of the model frame
  * M = (Y_L, -Z_L, -X_L) in the camera frame. */

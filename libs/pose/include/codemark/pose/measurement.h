@@ -108,6 +108,14 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** The same for the size-dependent (growth_y_px) part; negative: the top
 	 * and bottom lines tilt (line fits over few edge points), a phi2 error. */
 	double corr_growth_y12 = 0;
+	/** General path: the standard deviation of each vertical edge's
+	 * midpoint height in the image over that of its half-length y_i, and of
+	 * the edge's tilt (half the x difference of its ends) over that of its
+	 * x_i: the corners' four numbers that P does not hold
+	 * (cornerCovarianceFromPrimary()). 1: independent corners of equal
+	 * noise. ini keys `corner_midpoint_ratio`, `corner_tilt_ratio`. */
+	double corner_midpoint_ratio = 1.0;
+	double corner_tilt_ratio = 1.0;	 //!< see corner_midpoint_ratio
 	/** C_P of a measured or predicted P under these options (without the
 	 * detector's own sigma), the sum of a constant and a size-dependent part,
 	 * each with its correlation of the two edges:
