@@ -16,6 +16,7 @@ extern "C"
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -275,9 +276,7 @@ std::vector<CellResult> runSurvey(
 	{
 		scene.world_T_camera =
 			sim::levelCameraLookingAt(lm, c.distance_m, c.angle_deg * M_PI / 180);
-		const CPose3D landmark_T_camera = scene.world_T_camera - lm.world_T_landmark();
-		const SightingTruth truth = sightingTruth(landmark_T_camera);
-		// Predicted sigmas at the exact corners.
+		// Predicted sigmas at the exact corners of the cell's centred view.
 		{
 			const sim::Render exact = sim::render(scene, sim::RenderOptions(), o.seed);
 			const pose::Measurement m = pose::measure(exact.truth[0].corners_px, camera, g, cf);
@@ -290,6 +289,15 @@ std::vector<CellResult> runSurvey(
 		for (int r = 0; r < o.renders_per_cell; ++r)
 		{
 			const uint64_t seed = o.seed + 1000003ull * done + r;
+			// This render's aim and height (SurveyOptions::aim_jitter_rad).
+			std::mt19937_64 aim_rng(seed ^ 0x9e3779b97f4a7c15ull);
+			std::uniform_real_distribution<double> U(-1, 1);
+			const double bearing = o.aim_jitter_rad * U(aim_rng),
+						 height = o.height_jitter_m * U(aim_rng);
+			scene.world_T_camera = sim::levelCameraLookingAt(
+				lm, c.distance_m, c.angle_deg * M_PI / 180, height, bearing);
+			const CPose3D landmark_T_camera = scene.world_T_camera - lm.world_T_landmark();
+			const SightingTruth truth = sightingTruth(landmark_T_camera);
 			const sim::Render img = sim::render(scene, ro, seed);
 			++c.renders;
 			const auto res = detect::detect(img.image, camera, g, dopt);

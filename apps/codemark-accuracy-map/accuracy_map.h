@@ -42,6 +42,16 @@ struct SurveyOptions
 	 * of the paper's plain grey background; noise and blur as set. The
 	 * AprilTag renders keep the plain background. */
 	bool realistic = false;
+	/** Each render aims the camera off the landmark by a bearing drawn
+	 * uniformly within +-aim_jitter_rad and puts it higher or lower by up to
+	 * height_jitter_m (the cell fixes the camera's planar position): a robot
+	 * never looks exactly at a landmark's centre, and a landmark dead centre
+	 * in the image mirrors its left and right (top and bottom) edges' pixel
+	 * phases, so their sampling biases cancel in the bearing (and phi2) and
+	 * make C_P look 2x pessimistic there. 0, 0: exactly centred, the grid
+	 * before 2026-12-01. */
+	double aim_jitter_rad = 0.15;
+	double height_jitter_m = 0.2;  //!< see aim_jitter_rad [m]
 	uint64_t seed = 1;	//!< first render seed
 };
 

@@ -56,10 +56,11 @@ int main(int argc, char** argv)
 			false, "Fixed", "NAME", cmd);
 		TCLAP::ValueArg<std::string> calibration_arg(
 			"", "calibration",
-			"C_P model: realistic (the shipped detectorCalibratedPoseOptions, fitted on textured "
-			"walls) or plain (plainBackgroundPoseOptions, fitted on the plain background this map "
-			"renders by default). Default realistic.",
-			false, "realistic", "NAME", cmd);
+			"C_P model: plain (plainBackgroundPoseOptions, fitted on the plain background this "
+			"map renders by default), realistic (the shipped detectorCalibratedPoseOptions, "
+			"fitted on the textured, lit walls of --realistic) or scene (the one fitted on the "
+			"scene rendered). Default scene.",
+			false, "scene", "NAME", cmd);
 		TCLAP::SwitchArg paper_arg(
 			"", "paper-closed-form",
 			"The closed-form column uses the paper's formulas alone, without the weighted "
@@ -84,18 +85,20 @@ int main(int argc, char** argv)
 		o.max_distance_m = maxd_arg.getValue();
 		o.noise_sigma = noise_arg.getValue();
 		o.blur_sigma_px = blur_arg.getValue();
-		if (calibration_arg.getValue() == "plain")
+		std::string calibration = calibration_arg.getValue();
+		if (calibration == "scene") calibration = realistic_arg.getValue() ? "realistic" : "plain";
+		if (calibration == "plain")
 		{
 			o.pose = codemark::pipeline::plainBackgroundPoseOptions();
 			o.noise_label =
 				"calibrated on a plain background (pipeline::plainBackgroundPoseOptions)";
 		}
-		else if (calibration_arg.getValue() == "realistic")
+		else if (calibration == "realistic")
 			o.pose = codemark::pipeline::detectorCalibratedPoseOptions();
 		else
 			throw std::invalid_argument(
-				"--calibration: expected realistic or plain, got '" + calibration_arg.getValue() +
-				"'");
+				"--calibration: expected scene, plain or realistic, got '" +
+				calibration_arg.getValue() + "'");
 		if (sigma_arg.isSet())
 		{
 			o.pose = codemark::pose::PoseOptions();

@@ -132,7 +132,7 @@ struct Runner
 			detect::JsonFields f;
 			try
 			{
-				const auto m = pose::measure(d.detection.corners, camera, geometry, pose);
+				const auto m = pose::measure(d.detection, camera, geometry, pose);
 				f.emplace_back("L", jsonVector(m.L));
 				f.emplace_back("C_L", jsonMatrix(m.C_L));
 				f.emplace_back("pose_in_landmark", jsonVector(m.pose_in_landmark));

@@ -12,12 +12,15 @@
  */
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/primary.h>
+#include <codemark/pose/measurement.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
 #include <tclap/CmdLine.h>
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -37,6 +40,19 @@ struct Sample
 	double width_px;  // apparent width x2 - x1 (true) [px]
 	Eigen::Matrix<double, 8, 1> e_corner;  // (u, v) errors TL TR BR BL [px]
 	Eigen::Vector4d e_P;
+	std::array<bool, 4> clipped{};	// DetectionQuality::fill_clipped (top, right, bottom, left)
+	/** PoseOptions::aligned_edge_ratio's weight of the top and bottom edges:
+	 * 1 - the rows between their ends (true corners), 0 beyond one row. */
+	double aligned_weight = 0;
+	double rows_top = 0, rows_bottom = 0;  // rows between the top and bottom edges' ends [px]
+	Eigen::Vector4d P_true = Eigen::Vector4d::Zero();
+	/** Clipped sides on x1, x2 (left, right: 0 or 1) and on y1, y2 (top and bottom: 0-2). */
+	int clippedOn(int component) const
+	{
+		if (component == 0) return clipped[3];
+		if (component == 2) return clipped[1];
+		return int(clipped[0]) + int(clipped[2]);
+	}
 };
 }  // namespace
 
@@ -71,6 +87,11 @@ int main(int argc, char** argv)
 			"Ini file whose [render] section overrides the render options (after --realistic), "
 			"e.g. gradient, background, noise_sigma, blur_sigma_px.",
 			false, "", "FILE", cmd);
+		TCLAP::ValueArg<double> level_arg(
+			"", "level-fraction",
+			"Fraction of the renders with the camera exactly at the landmark's height (top and "
+			"bottom edges along pixel rows: PoseOptions::aligned_edge_ratio). Default 0.",
+			false, 0, "F", cmd);
 		TCLAP::SwitchArg uniform_distance_arg(
 			"", "uniform-distance",
 			"Draw distances uniformly (each distance as often) instead of uniformly in area (as "
@@ -123,8 +144,9 @@ int main(int argc, char** argv)
 								 ? r0 + U(rng) * (r1 - r0)
 								 : std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
 			const double a = (2 * U(rng) - 1) * amax_arg.getValue();
-			const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue(),
-						 height = (2 * U(rng) - 1) * height_arg.getValue();
+			const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue();
+			double height = (2 * U(rng) - 1) * height_arg.getValue();
+			if (U(rng) < level_arg.getValue()) height = 0;
 			scene.world_T_camera =
 				sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
 			const sim::Render img = sim::render(scene, ro, seed_arg.getValue() * 100003 + i);
@@ -143,6 +165,13 @@ int main(int argc, char** argv)
 						s.e_corner.segment<2>(2 * k) =
 							dl.detection.corners[k] - img.truth[0].corners_px[k];
 					s.e_P = primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
+					s.clipped = dl.detection.quality.fill_clipped;
+					const auto& tc = img.truth[0].corners_px;
+					s.P_true = img.truth[0].P;
+					s.rows_top = tc[1].y() - tc[0].y();
+					s.rows_bottom = tc[2].y() - tc[3].y();
+					for (const double rows : {tc[1].y() - tc[0].y(), tc[2].y() - tc[3].y()})
+						s.aligned_weight += std::max(0.0, 1 - std::abs(rows));
 					samples.push_back(s);
 					found = true;
 					break;
@@ -153,59 +182,98 @@ int main(int argc, char** argv)
 		{
 			std::ofstream f(csv_arg.getValue());
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
-				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2\n";
+				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
+				 "clipped_left\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
 				for (int k = 0; k < 8; ++k) f << "," << s.e_corner[k];
 				for (int k = 0; k < 4; ++k) f << "," << s.e_P[k];
+				for (int k = 0; k < 4; ++k) f << "," << int(s.clipped[k]);
 				f << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
 
 		// Maximum-likelihood fit (grid search) of the noise model of
-		// PoseOptions::primaryCovariance: each component of P has
-		// sigma(s) = sqrt(floor^2 + (growth (ref / s)^exponent)^2), s the
-		// apparent width x2 - x1 for x1, x2 and the apparent height y1 + y2
-		// for y1, y2; then the correlations of the normalised errors.
+		// PoseOptions::primaryCovariance and clippedSidesCovariance: each
+		// component of P has sigma(s)^2 = floor^2 + (growth (ref /
+		// s)^exponent)^2 + its clipped sides' share of clip^2, s the apparent
+		// width x2 - x1 for x1, x2 and the apparent height y1 + y2 for y1, y2
+		// (a clipped left or right side adds clip^2 to x1 or x2, a clipped top
+		// or bottom clip^2 / 4 to both y1 and y2); one clip for all sides
+		// (the x and y fits' summed likelihood); then the correlations of the
+		// normalised errors.
 		const double ref = 30;
 		struct Fit
 		{
-			double nll = 1e300, floor = 0, growth = 0, exponent = 0;
+			double nll = 1e300, floor = 0, growth = 0, exponent = 0, clip = 0;
+			/** Variance of component c of sample s. */
+			double var(const Sample& s, int c, double size) const
+			{
+				const double g = growth * std::pow(30 / size, exponent);
+				const double share = c % 2 == 0 ? 1.0 : 0.25;
+				return floor * floor + g * g + share * s.clippedOn(c) * clip * clip;
+			}
 		};
 		const auto sizeOf = [](const Sample& s, bool x) { return x ? s.width_px : s.side_px; };
-		const auto fit = [&](bool x)
+		constexpr int kExponents = 17;
+		std::vector<std::array<double, kExponents>> size_pow[2];
+		for (int x = 0; x < 2; ++x)
+			for (const auto& s : samples)
+			{
+				std::array<double, kExponents> t{};
+				for (int k = 0; k < kExponents; ++k) t[k] = std::pow(ref / sizeOf(s, x), 0.25 * k);
+				size_pow[x].push_back(t);
+			}
+		const auto fit = [&](bool x, double clip)
 		{
 			Fit best;
-			for (int i = 1; i <= 16; ++i)
+			for (int i = 1; i <= 32; ++i)
 				for (int j = 1; j <= 40; ++j)
-					for (int k = 0; k <= 16; ++k)
+					for (int k = 0; k < kExponents; ++k)
 					{
-						const double fl = 0.0025 * i, gr = 0.005 * j, ex = 0.25 * k;
+						const double fl = 0.00125 * i, gr = 0.005 * j;
 						double nll = 0;
-						for (const auto& s : samples)
+						for (size_t n = 0; n < samples.size(); ++n)
 						{
-							const double g = gr * std::pow(ref / sizeOf(s, x), ex);
-							const double v = fl * fl + g * g;
+							const Sample& s = samples[n];
+							const double g = gr * size_pow[x][n][k];
 							for (const int c : {x ? 0 : 1, x ? 2 : 3})
+							{
+								const double v =
+									fl * fl + g * g +
+									(c % 2 == 0 ? 1.0 : 0.25) * s.clippedOn(c) * clip * clip;
 								nll += s.e_P[c] * s.e_P[c] / v + std::log(v);
+							}
 						}
-						if (nll < best.nll) best = {nll, fl, gr, ex};
+						if (nll < best.nll) best = {nll, fl, gr, 0.25 * k, clip};
 					}
 			return best;
 		};
-		const Fit fx = fit(true), fy = fit(false);
+		int n_clipped = 0;
+		for (const auto& s : samples)
+			for (const bool c : s.clipped) n_clipped += c;
+		Fit fx, fy;
+		for (int m = 0; m <= (n_clipped > 20 ? 16 : 0); ++m)
+		{
+			const double clip = 0.005 * m;
+			const Fit a = fit(true, clip), b = fit(false, clip);
+			if (a.nll + b.nll < fx.nll + fy.nll)
+			{
+				fx = a;
+				fy = b;
+			}
+		}
 		double cxx = 0, cyy = 0, c12x = 0, c12y = 0;
 		for (const auto& s : samples)
 		{
-			const auto sig = [&](const Fit& f, double size)
+			Eigen::Vector4d z;
+			for (int c = 0; c < 4; ++c)
 			{
-				const double g = f.growth * std::pow(ref / size, f.exponent);
-				return std::sqrt(f.floor * f.floor + g * g);
-			};
-			const double sx = sig(fx, s.width_px), sy = sig(fy, s.side_px);
-			const Eigen::Vector4d z(s.e_P[0] / sx, s.e_P[1] / sy, s.e_P[2] / sx, s.e_P[3] / sy);
+				const bool x = c % 2 == 0;
+				z[c] = s.e_P[c] / std::sqrt((x ? fx : fy).var(s, c, sizeOf(s, x)));
+			}
 			cxx += (z[0] * z[0] + z[2] * z[2]) / 2;
 			cyy += (z[1] * z[1] + z[3] * z[3]) / 2;
 			c12x += z[0] * z[2];
@@ -217,19 +285,28 @@ int main(int argc, char** argv)
 		const auto fitCorr = [&](const Fit& f, bool x, double& r_floor, double& r_growth)
 		{
 			double best = 1e300;
-			for (int i = -19; i <= 19; ++i)
-				for (int j = -19; j <= 19; ++j)
+			// |r| <= 0.8: two edges fitted apart are never almost fully
+			// correlated; a floor far below the growth leaves its own
+			// correlation undetermined, and the grid's edge would make C_P
+			// nearly singular where the floor dominates (large landmarks).
+			for (int i = -16; i <= 16; ++i)
+				for (int j = -16; j <= 16; ++j)
 				{
 					const double rf = 0.05 * i, rg = 0.05 * j;
 					double nll = 0;
 					for (const auto& s : samples)
 					{
+						const int c1 = x ? 0 : 1, c2 = x ? 2 : 3;
 						const double g = f.growth * std::pow(ref / sizeOf(s, x), f.exponent);
-						const double v = f.floor * f.floor + g * g,
-									 c = rf * f.floor * f.floor + rg * g * g;
-						const double det = v * v - c * c;
-						const double e1 = s.e_P[x ? 0 : 1], e2 = s.e_P[x ? 2 : 3];
-						nll += (v * e1 * e1 - 2 * c * e1 * e2 + v * e2 * e2) / det + std::log(det);
+						const double v1 = f.var(s, c1, sizeOf(s, x)),
+									 v2 = f.var(s, c2, sizeOf(s, x));
+						// A clipped top or bottom moves y1 and y2 together.
+						const double c = rf * f.floor * f.floor + rg * g * g +
+										 (x ? 0.0 : 0.25 * s.clippedOn(1) * f.clip * f.clip);
+						const double det = v1 * v2 - c * c;
+						const double e1 = s.e_P[c1], e2 = s.e_P[c2];
+						nll +=
+							(v2 * e1 * e1 - 2 * c * e1 * e2 + v1 * e2 * e2) / det + std::log(det);
 					}
 					if (nll < best)
 					{
@@ -265,21 +342,203 @@ int main(int argc, char** argv)
 		double zm = 0, zt = 0;
 		for (const auto& s : samples)
 		{
-			const auto var = [&](const Fit& f, double size)
-			{
-				const double g = f.growth * std::pow(ref / size, f.exponent);
-				return f.floor * f.floor + g * g;
-			};
-			const double vx = var(fx, s.width_px), vy = var(fy, s.side_px);
 			const auto& e = s.e_corner;	 // TL.u TL.v TR.u TR.v BR.u BR.v BL.u BL.v
 			const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
 			const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
-			zm += (m1 * m1 + m2 * m2) / (2 * vy);
-			zt += (t1 * t1 + t2 * t2) / (2 * vx);
+			zm += (m1 * m1 / fy.var(s, 1, s.side_px) + m2 * m2 / fy.var(s, 3, s.side_px)) / 2;
+			zt += (t1 * t1 / fx.var(s, 0, s.width_px) + t2 * t2 / fx.var(s, 2, s.width_px)) / 2;
 		}
+		std::printf(
+			"  clipped_side_sigma_px %.3f (%d clipped sides of %zu)\n", fx.clip, n_clipped,
+			4 * samples.size());
 		std::printf(
 			"  corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n", std::sqrt(zm / samples.size()),
 			std::sqrt(zt / samples.size()));
+		// The same tabulated against size (PoseOptions::sigma_x_table,
+		// sigma_y_table): the maximum-likelihood sigma of each size bin (at
+		// least 60 detections, at most 12 bins), with the clipped sides' term
+		// above; one correlation of the two edges; the corner ratios again.
+		{
+			const double clip2 = fx.clip * fx.clip;
+			const auto share = [&](const Sample& s, int c)
+			{ return (c % 2 == 0 ? 1.0 : 0.25) * s.clippedOn(c) * clip2; };
+			// The aligned edges' variance over the table's: y components only.
+			double k_aligned = 0;
+			const auto aligned = [&](const Sample& s, int c)
+			{ return c % 2 == 0 ? 0.0 : 0.25 * k_aligned * k_aligned * s.aligned_weight; };
+			const auto table = [&](bool x)
+			{
+				std::vector<size_t> order(samples.size());
+				for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+				std::sort(
+					order.begin(), order.end(),
+					[&](size_t a, size_t b)
+					{ return sizeOf(samples[a], x) < sizeOf(samples[b], x); });
+				// Bins a factor 1.25 in size wide, of at least 40 detections.
+				pose::SigmaTable t;
+				size_t b0 = 0;
+				while (b0 < order.size())
+				{
+					size_t b1 = b0;
+					const double start = sizeOf(samples[order[b0]], x);
+					while (b1 < order.size() &&
+						   (b1 - b0 < 40 || sizeOf(samples[order[b1]], x) < 1.25 * start))
+						++b1;
+					// A short remainder joins the last bin.
+					if (order.size() - b1 < 40) b1 = order.size();
+					double best = 1e300, best_sigma = 0;
+					for (int g = 0; g <= 400; ++g)
+					{
+						const double sg = 1e-4 * std::pow(1e4, g / 400.0), v0 = sg * sg;
+						double nll = 0;
+						for (size_t k = b0; k < b1; ++k)
+						{
+							const Sample& s = samples[order[k]];
+							for (const int c : {x ? 0 : 1, x ? 2 : 3})
+							{
+								const double v = v0 * (1 + aligned(s, c)) + share(s, c);
+								nll += s.e_P[c] * s.e_P[c] / v + std::log(v);
+							}
+						}
+						if (nll < best)
+						{
+							best = nll;
+							best_sigma = sg;
+						}
+					}
+					// The bin's median size, rounded (0.1 px, 3 digits of sigma).
+					const double size =
+						std::round(10 * sizeOf(samples[order[(b0 + b1) / 2]], x)) / 10;
+					const double p10 = std::pow(10, std::floor(std::log10(best_sigma)) - 2);
+					if (t.empty() || size > t.back().first)
+						t.emplace_back(size, std::round(best_sigma / p10) * p10);
+					b0 = b1;
+				}
+				return t;
+			};
+			pose::SigmaTable tx = table(true), ty = table(false);
+			const auto var = [&](const Sample& s, int c)
+			{
+				const bool x = c % 2 == 0;
+				return std::pow(pose::interpolateSigma(x ? tx : ty, sizeOf(s, x)), 2) *
+						   (1 + aligned(s, c)) +
+					   share(s, c);
+			};
+			double rx = 0, ry = 0;
+			// k_aligned by maximum likelihood on y1, y2 given the table, the
+			// table again given it (three rounds).
+			const int n_aligned = static_cast<int>(std::count_if(
+				samples.begin(), samples.end(),
+				[](const Sample& s) { return s.aligned_weight > 0.5; }));
+			for (int round = 0; round < 3 && n_aligned >= 20; ++round)
+			{
+				double best = 1e300, best_k = 0;
+				for (int i = 0; i <= 40; ++i)
+				{
+					k_aligned = 0.1 * i;
+					double nll = 0;
+					for (const auto& s : samples)
+					{
+						const double t2 = std::pow(pose::interpolateSigma(ty, s.side_px), 2);
+						const double v = var(s, 1), c = aligned(s, 1) * t2 + share(s, 1) - 0.0;
+						// y1, y2 share the aligned and clipped shifts.
+						const double det = v * v - c * c;
+						const double e1 = s.e_P[1], e2 = s.e_P[3];
+						nll += (v * e1 * e1 - 2 * c * e1 * e2 + v * e2 * e2) / det + std::log(det);
+					}
+					if (nll < best)
+					{
+						best = nll;
+						best_k = k_aligned;
+					}
+				}
+				k_aligned = best_k;
+				ty = table(false);
+			}
+			for (const bool x : {true, false})
+			{
+				double best = 1e300;
+				for (int i = -16; i <= 16; ++i)
+				{
+					const double r = 0.05 * i;
+					double nll = 0;
+					for (const auto& s : samples)
+					{
+						const int c1 = x ? 0 : 1, c2 = x ? 2 : 3;
+						const double v1 = var(s, c1), v2 = var(s, c2);
+						const double t2 =
+							std::pow(pose::interpolateSigma(x ? tx : ty, sizeOf(s, x)), 2);
+						const double c = r * t2 + (x ? 0.0 : share(s, 1) + aligned(s, 1) * t2);
+						const double det = v1 * v2 - c * c;
+						const double e1 = s.e_P[c1], e2 = s.e_P[c2];
+						nll +=
+							(v2 * e1 * e1 - 2 * c * e1 * e2 + v1 * e2 * e2) / det + std::log(det);
+					}
+					if (nll < best)
+					{
+						best = nll;
+						(x ? rx : ry) = r;
+					}
+				}
+			}
+			double zx = 0, zy = 0, zm2 = 0, zt2 = 0;
+			for (const auto& s : samples)
+			{
+				zx += (s.e_P[0] * s.e_P[0] / var(s, 0) + s.e_P[2] * s.e_P[2] / var(s, 2)) / 2;
+				zy += (s.e_P[1] * s.e_P[1] / var(s, 1) + s.e_P[3] * s.e_P[3] / var(s, 3)) / 2;
+				const auto& e = s.e_corner;
+				const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
+				const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
+				zm2 += (m1 * m1 / var(s, 1) + m2 * m2 / var(s, 3)) / 2;
+				zt2 += (t1 * t1 / var(s, 0) + t2 * t2 / var(s, 2)) / 2;
+			}
+			const double n = samples.size();
+			std::printf("tabulated fit (the same clipped_side_sigma_px):\n");
+			std::printf("  sigma_x_table = %s\n", pose::toString(tx).c_str());
+			std::printf("  sigma_y_table = %s\n", pose::toString(ty).c_str());
+			std::printf(
+				"  corr_growth_x12 %+.2f corr_growth_y12 %+.2f; normalised variance x %.3f y %.3f; "
+				"corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n",
+				rx, ry, zx / n, zy / n, std::sqrt(zm2 / n), std::sqrt(zt2 / n));
+			std::printf(
+				"  aligned_edge_ratio %.1f (%d detections with a top or bottom edge along a row)\n",
+				k_aligned, n_aligned);
+			// The clipped sides' sigma again and the correlation of their
+			// shifts, by maximum likelihood of all of P under the pose
+			// library's own C_P with the tables above.
+			pose::PoseOptions po;
+			po.sigma_x_table = tx;
+			po.sigma_y_table = ty;
+			po.corr_growth_x12 = rx;
+			po.corr_growth_y12 = ry;
+			po.aligned_edge_ratio = k_aligned;
+			double best = 1e300, best_s = fx.clip, best_r = 0;
+			for (int i = 1; i <= 20 && n_clipped > 20; ++i)
+				for (int j = 0; j <= 9; ++j)
+				{
+					po.clipped_side_sigma_px = 0.005 * i;
+					po.clipped_side_correlation = 0.1 * j;
+					double nll = 0;
+					for (const auto& sm : samples)
+					{
+						const Eigen::Matrix4d C =
+							po.primaryCovariance(sm.P_true) +
+							po.clippedSidesCovariance(sm.clipped) +
+							po.alignedEdgesCovariance(sm.P_true, sm.rows_top, sm.rows_bottom);
+						const Eigen::LDLT<Eigen::Matrix4d> ldlt(C);
+						nll += sm.e_P.dot(ldlt.solve(sm.e_P)) + ldlt.vectorD().array().log().sum();
+					}
+					if (nll < best)
+					{
+						best = nll;
+						best_s = po.clipped_side_sigma_px;
+						best_r = po.clipped_side_correlation;
+					}
+				}
+			std::printf(
+				"  all of P: clipped_side_sigma_px %.3f clipped_side_correlation %.1f\n", best_s,
+				best_r);
+		}
 		std::printf(
 			"%-9s %5s %7s | %7s %7s | %7s %7s %7s %7s | %6s %6s %6s\n", "band", "n", "side",
 			"rms_u", "rms_v", "sd_x1", "sd_y1", "sd_x2", "sd_y2", "r_y1y2", "r_x1x2", "r_uTB");

@@ -79,6 +79,7 @@ void expectSame(const CObservationCodedLandmarks& a, const CObservationCodedLand
 		EXPECT_EQ(x.quality.code_margin, y.quality.code_margin);
 		EXPECT_EQ(x.quality.area_px, y.quality.area_px);
 		EXPECT_EQ(x.quality.corner_sigma_px, y.quality.corner_sigma_px);
+		EXPECT_EQ(x.quality.fill_clipped, y.quality.fill_clipped);
 		EXPECT_EQ(x.method, y.method);
 	}
 }
@@ -118,6 +119,19 @@ TEST(CodedLandmarksObs, GoldenFileStaysReadable)
 		std::dynamic_pointer_cast<CObservationCodedLandmarks>(codemark::test::fromBytes(bytes));
 	ASSERT_TRUE(back);
 	expectSame(makeFilled(), *back);
+}
+
+TEST(CodedLandmarksObs, ClippedSidesRoundTrip)
+{
+	// Version 1's clipped-sides bits (the golden file above is version 0:
+	// read back as none clipped).
+	auto o = makeFilled();
+	o.sightings[0].quality.fill_clipped = {{true, true, false, false}};
+	o.sightings[1].quality.fill_clipped = {{false, true, false, true}};
+	const auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(
+		codemark::test::fromBytes(codemark::test::toBytes(o)));
+	ASSERT_TRUE(back);
+	expectSame(o, *back);
 }
 
 TEST(CodedLandmarksObs, TruncatedBytesThrow)

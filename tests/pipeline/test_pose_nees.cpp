@@ -86,8 +86,7 @@ const NeesResult& neesOnRenders()
 				int k = 0;
 				for (const pose::PoseOptions* o : {&cf, &gen})
 				{
-					const pose::Measurement m =
-						pose::measure(dl.detection.corners, scene.camera, g, *o);
+					const pose::Measurement m = pose::measure(dl.detection, scene.camera, g, *o);
 					if (std::sqrt(m.C_L(2, 2)) <= 2 * M_PI / 180)
 					{
 						Eigen::Vector3d e = m.pose_in_landmark - truth.pose_in_landmark;
@@ -168,7 +167,7 @@ TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 				pose::PoseOptions o = pipeline::detectorCalibratedPoseOptions();
 				o.method = method;
 				const pose::Measurement m =
-					pose::measure(det.landmarks[0].detection.corners, scene.camera, g, o);
+					pose::measure(det.landmarks[0].detection, scene.camera, g, o);
 				const std::string what = pose::toString(method) + " at " + std::to_string(d) +
 										 " m, " + std::to_string(deg) + " deg";
 				EXPECT_NEAR(m.L[0], t.L[0], 1e-3 * t.L[0]) << what;

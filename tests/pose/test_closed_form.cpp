@@ -429,6 +429,91 @@ TEST(PrimaryCovariance, SizeDependentModel)
 	EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
+// The tabulated sigma, the clipped sides' and the aligned edges' terms.
+TEST(PrimaryCovariance, TablesClippedSidesAndAlignedEdges)
+{
+	const SigmaTable t = sigmaTableFromString("20:0.08 40:0.02 80:0.005");
+	ASSERT_EQ(t.size(), 3u);
+	EXPECT_DOUBLE_EQ(interpolateSigma(t, 10), 0.08);  // the ends beyond the table
+	EXPECT_DOUBLE_EQ(interpolateSigma(t, 200), 0.005);
+	EXPECT_NEAR(interpolateSigma(t, 40), 0.02, 1e-15);
+	EXPECT_NEAR(interpolateSigma(t, std::sqrt(20.0 * 40)), 0.04, 1e-12);  // log-log midpoint
+	EXPECT_EQ(sigmaTableFromString(toString(t)), t);
+	EXPECT_TRUE(sigmaTableFromString("").empty());
+	for (const char* bad : {"20:0.08 20:0.01", "20;0.08", "20:", "x:0.1", "20:-1", "20:0.1abc"})
+		EXPECT_THROW(sigmaTableFromString(bad), std::invalid_argument) << bad;
+
+	PoseOptions o;
+	o.sigma_x_table = t;
+	o.sigma_y_table = sigmaTableFromString("40:0.03");
+	o.corr_growth_x12 = -0.5;
+	o.corr_growth_y12 = 0.25;
+	const Eigen::Vector4d P(-20, 20, 20, 20);  // width 40 px, height 40 px
+	const Eigen::Matrix4d C = o.primaryCovariance(P);
+	EXPECT_NEAR(C(0, 0), 0.02 * 0.02, 1e-15);
+	EXPECT_NEAR(C(0, 2), -0.5 * 0.02 * 0.02, 1e-15);
+	EXPECT_NEAR(C(3, 3), 0.03 * 0.03, 1e-15);
+	EXPECT_NEAR(C(1, 3), 0.25 * 0.03 * 0.03, 1e-15);
+	mrpt::config::CConfigFileMemory cfg;
+	o.clipped_side_sigma_px = 0.04;
+	o.clipped_side_correlation = 0.5;
+	o.aligned_edge_ratio = 2;
+	o.saveToConfigFile(cfg, "POSE");
+	PoseOptions r;
+	r.loadFromConfigFile(cfg, "POSE");
+	EXPECT_EQ(r.sigma_x_table, o.sigma_x_table);
+	EXPECT_EQ(r.sigma_y_table, o.sigma_y_table);
+	EXPECT_DOUBLE_EQ(r.clipped_side_correlation, 0.5);
+
+	// Clipped sides: a left side moves x1 alone, a top both half-lengths by
+	// half its shift; two clipped sides' shifts correlate.
+	const double v = 0.04 * 0.04;
+	Eigen::Matrix4d K = o.clippedSidesCovariance({{false, false, false, true}});
+	EXPECT_NEAR(K(0, 0), v, 1e-18);
+	EXPECT_NEAR(K.norm(), v, 1e-18);
+	K = o.clippedSidesCovariance({{true, false, false, false}});
+	EXPECT_NEAR(K(1, 1), v / 4, 1e-18);
+	EXPECT_NEAR(K(1, 3), v / 4, 1e-18);
+	K = o.clippedSidesCovariance({{false, true, false, true}});	 // right and left
+	EXPECT_NEAR(K(0, 2), -0.5 * v, 1e-18);	// outward shifts: x1 down, x2 up
+	// The same by sampling the sides' shifts.
+	std::mt19937 rng(5);
+	std::normal_distribution<double> n(0, 1);
+	Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
+	const int N = 100000;
+	for (int i = 0; i < N; ++i)
+	{
+		const double common = n(rng), a = n(rng), b = n(rng);
+		const double dr = 0.04 * (std::sqrt(0.5) * common + std::sqrt(0.5) * a);
+		const double dl = 0.04 * (std::sqrt(0.5) * common + std::sqrt(0.5) * b);
+		const Eigen::Vector4d e(-dl, 0, dr, 0);
+		S += e * e.transpose() / N;
+	}
+	EXPECT_LT((S - K).norm(), 0.02 * K.norm());
+
+	// measure() of a detection adds them: its flags, its corners' rows.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	Detection d;
+	d.corners = projectCorners(cameraAt(2.0, 0.3), cam, g);
+	PoseOptions m;
+	m.clipped_side_sigma_px = 0.04;
+	const Eigen::Matrix4d before = measure(d, cam, g, m).C_P;
+	d.quality.fill_clipped = {{false, false, false, true}};
+	EXPECT_NEAR(measure(d, cam, g, m).C_P(0, 0) - before(0, 0), v, 1e-15);
+	EXPECT_NEAR(measure(d.corners, cam, g, m).C_P(0, 0), before(0, 0), 1e-15);
+
+	// Aligned edges: full weight on a row, none a row or more apart.
+	PoseOptions a;
+	a.sigma_y_px = 0.02;
+	a.aligned_edge_ratio = 2;
+	const Eigen::Matrix4d A0 = a.alignedEdgesCovariance(P, 0, 0);
+	EXPECT_NEAR(A0(1, 1), 2 * 0.25 * 4 * 0.02 * 0.02, 1e-18);
+	EXPECT_NEAR(A0(1, 3), A0(1, 1), 1e-18);
+	EXPECT_NEAR(a.alignedEdgesCovariance(P, 0.5, -1.5)(1, 1), A0(1, 1) / 4, 1e-18);
+	EXPECT_EQ(a.alignedEdgesCovariance(P, 1.0, 2.0).norm(), 0);
+}
+
 // The second-order C_R against the sample covariance of the exact pose of
 // Gaussian L samples, where phi2 is uncertain enough for first order to miss.
 TEST(PoseCovariance, SecondOrderMatchesSamples)

@@ -111,6 +111,7 @@ DetectionResult detect(
 					   std::max(1, refined->sides[k].support);
 		}
 		qual.corner_sigma_px = std::sqrt(var_end / 4);
+		qual.fill_clipped = refined->fill_clipped;
 		qual.code_margin = code->margin;
 		const auto& c = refined->corners_ideal;
 		double area2 = 0;

@@ -179,7 +179,7 @@ struct ClippedSideProfiles
  * peak and centroid outwards (the square looks larger): by 0.012 px where
  * only the noise of a fill at exactly 255 clips, 0.05 px at gains of
  * 1.1-1.6 within 2 m and up to 0.5 px on 4-5 px frames.
- * Where part of the fill band is unclipped, imputeClippedNoise() does it
+ * Where part of the fill band is unclipped, imputeClippedFill() does it
  * before the edges are first located. Where all of it clips: a Gaussian-blurred, pixel-integrated
  * step (with the frame's outer edge below 7 px) in B, G and R, the side's blur and levels shared
  * and the edge a quadratic along the side, is fitted by maximum likelihood with the samples at 255
@@ -197,7 +197,7 @@ bool imputeClippedSide(
 	double frame_px, double fill_px, double noise, std::vector<int>& g_profiles);
 
 /** The G samples of a side's fill band (profile indices i0..i1 of each
- * profile): how many are at the sensor's top, and the others. */
+ * profile): how many are at the sensor's top, how many below. */
 struct ClippedFill
 {
 	int clipped = 0;  //!< samples at 255
@@ -208,12 +208,22 @@ struct ClippedFill
 };
 ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1);
 
-/** Where part of a fill band is unclipped, only its noise clips: its level
- * and noise follow from where the clip cuts its samples' distribution
- * \a fill and from their unclipped median (a censored normal), and every
+/** Where part of a fill band is unclipped, only its noise clips: every
  * sample at 255 of \a g_profiles gets the expectation of a sample above the
- * clip. False (nothing changed) with under 10 samples on either side. */
-bool imputeClippedNoise(std::vector<int>& g_profiles, const ClippedFill& fill);
+ * clip at its place. The fill's level, linear along and across the side (a
+ * light gradient), and its noise follow by censored (Tobit) regression of
+ * the band's samples (profile indices i0..i1 of each \a n-sample profile,
+ * \a fill their tally); where the level is constant to within the noise,
+ * from \a fill's median and clipped fraction (a censored normal, robust to
+ * the band's few samples of neighbouring blur). False (nothing changed)
+ * with under 10 samples on either side, without convergence, or where the
+ * level lies above the clip by more than the noise somewhere in the band
+ * (\a fill_above then true): there the edges' transitions clip too,
+ * imputeClippedSide()'s case. Without \a fill_above it imputes there too
+ * (the fallback where that model is refused). */
+bool imputeClippedFill(
+	std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill,
+	bool* fill_above = nullptr);
 
 /** The noise of G [grey levels] in the always-black centre code cell of the
  * quadrangle \a coarse (around its diagonals' intersection, the projected
@@ -242,6 +252,8 @@ struct RefinedQuad
 	Quad corners_raw;  //!< TL, TR, BR, BL in raw (distorted) pixels
 	Quad corners_ideal;	 //!< the same undistorted
 	std::array<LineFit, 4> sides;  //!< top, right, bottom, left, in undistorted px
+	/** Per side: its fill clipped throughout (DetectionQuality::fill_clipped). */
+	std::array<bool, 4> fill_clipped{{false, false, false, false}};
 };
 
 /** Edge profiles along each side of \a coarse (one per row or column), the

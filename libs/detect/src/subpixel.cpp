@@ -295,18 +295,27 @@ std::optional<RefinedQuad> refineQuadrangle(
 		bool side_saturated = saturated > half_count;
 		const bool side_clipped = clipped > half_count;
 		// Where G clips, restore the clipped samples before the edges are
-		// read (imputeClippedNoise(), imputeClippedSide()): the clip cuts the
+		// read (imputeClippedFill(), imputeClippedSide()): the clip cuts the
 		// bright half of the response. The fill band from the coarse line
 		// (within about a pixel of the edge): beyond the edge's blur, short
 		// of the code board.
 		const double fill_px = frame_px * fill_ratio / frame_ratio;
-		const ClippedFill band =
-			clippedFill(g_prof, n, half + 3, half + static_cast<int>(std::floor(fill_px - 3)));
+		const int band0 = half + 3, band1 = half + static_cast<int>(std::floor(fill_px - 3));
+		const ClippedFill band = clippedFill(g_prof, n, band0, band1);
 		const bool clips = p.model_clipping && band.count() >= kMinFillSamples &&
 						   band.fraction() > p.clipped_fraction;
-		const bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
-		// Part of the fill unclipped: only its noise clips.
-		if (clips && !all_clipped && imputeClippedNoise(g_prof, band)) side_saturated = false;
+		bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
+		// Part of the fill unclipped: only its noise clips, unless its level
+		// is above the clip somewhere.
+		bool above_clip = false;  // part unclipped, but the level above the clip
+		if (clips && !all_clipped)
+		{
+			// A level above the clip is the edge model's case too (the
+			// transitions clip).
+			if (imputeClippedFill(g_prof, n, band0, band1, band, &all_clipped))
+				side_saturated = false;
+			above_clip = all_clipped;
+		}
 		std::vector<std::optional<double>> edges(pos.size());
 		const auto locateAll = [&](bool saturated_path)
 		{
@@ -355,6 +364,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 		locateAll(side_saturated);
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
+		out.fill_clipped[side] = all_clipped || (band.count() >= kMinFillSamples &&
+												 band.fraction() >= kAllClippedFraction);
 		if (all_clipped)
 		{
 			if (noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
@@ -366,6 +377,10 @@ std::optional<RefinedQuad> refineQuadrangle(
 			clip_side.along = pos;
 			for (const int c0 : origin) clip_side.base.push_back(c0 - inward * half);
 			if (imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
+				locateAll(false);
+			// Refused (a JPEG's chroma, a sharp edge) where part of the fill
+			// is unclipped: the fill's own model still restores its noise.
+			else if (above_clip && imputeClippedFill(g_prof, n, band0, band1, band))
 				locateAll(false);
 		}
 		std::vector<Eigen::Vector2d> pts;

@@ -45,7 +45,8 @@ CObservationCodedLandmarks::TSighting CObservationCodedLandmarks::TSighting::Fro
 	return s;
 }
 
-uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 0; }
+// Version 1 adds DetectionQuality::fill_clipped (a bit per side).
+uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 1; }
 
 void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -66,6 +67,9 @@ void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out)
 		out << s.quality.code_margin << s.quality.area_px << s.quality.corner_sigma_px;
 		// Stored as pose::PoseMethod's value: ClosedForm = 0, General6Dof = 1.
 		out.WriteAs<uint8_t>(static_cast<uint8_t>(s.method));
+		uint8_t clipped = 0;
+		for (int k = 0; k < 4; ++k) clipped |= s.quality.fill_clipped[k] ? (1u << k) : 0u;
+		out.WriteAs<uint8_t>(clipped);
 	}
 }
 
@@ -74,6 +78,7 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 	switch (version)
 	{
 		case 0:
+		case 1:
 		{
 			in >> timestamp >> sensorLabel >> cameraPose >> camera;
 			const auto n = in.ReadAs<uint32_t>();
@@ -104,6 +109,15 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 						"CObservationCodedLandmarks: corrupt data, pose method %u",
 						static_cast<unsigned>(m));
 				s.method = static_cast<pose::PoseMethod>(m);
+				if (version >= 1)
+				{
+					const auto clipped = in.ReadAs<uint8_t>();
+					if (clipped > 15)
+						THROW_EXCEPTION_FMT(
+							"CObservationCodedLandmarks: corrupt data, clipped-sides mask %u",
+							static_cast<unsigned>(clipped));
+					for (int k = 0; k < 4; ++k) s.quality.fill_clipped[k] = (clipped >> k) & 1u;
+				}
 				// A detection never has a non-finite measurement; such a value
 				// would only poison a filter later, far from its cause.
 				bool finite = s.P.allFinite() && s.L.allFinite() && s.C_L.allFinite() &&

@@ -31,7 +31,7 @@ ImageResult processImage(
 		try
 		{
 			m.measurement =
-				pose::measure(d.detection.corners, camera, geometryFor(d.detection.id, o), o.pose);
+				pose::measure(d.detection, camera, geometryFor(d.detection.id, o), o.pose);
 		}
 		catch (const std::invalid_argument&)
 		{

@@ -46,6 +46,56 @@ PoseMethod poseMethodFromString(const std::string& name)
 		"unknown pose method '" + name + "' (expected ClosedForm or General6Dof)");
 }
 
+double interpolateSigma(const SigmaTable& t, double size)
+{
+	if (size <= t.front().first) return t.front().second;
+	if (size >= t.back().first) return t.back().second;
+	const auto hi = std::upper_bound(
+		t.begin(), t.end(), size, [](double s, const auto& e) { return s < e.first; });
+	const auto lo = hi - 1;
+	const double f = std::log(size / lo->first) / std::log(hi->first / lo->first);
+	return std::exp((1 - f) * std::log(lo->second) + f * std::log(hi->second));
+}
+
+SigmaTable sigmaTableFromString(const std::string& text)
+{
+	SigmaTable t;
+	std::istringstream in(text);
+	std::string entry;
+	while (in >> entry)
+	{
+		const auto colon = entry.find(':');
+		double size = 0, sigma = 0;
+		size_t used_a = 0, used_b = 0;
+		try
+		{
+			if (colon == std::string::npos) throw std::invalid_argument("no colon");
+			size = std::stod(entry.substr(0, colon), &used_a);
+			sigma = std::stod(entry.substr(colon + 1), &used_b);
+		}
+		catch (const std::exception&)
+		{
+			used_a = 0;
+		}
+		if (colon == std::string::npos || used_a != colon || used_b != entry.size() - colon - 1 ||
+			!(size > 0) || !(sigma > 0) || !std::isfinite(size) || !std::isfinite(sigma))
+			throw std::invalid_argument(
+				"sigma table: bad entry '" + entry + "' (expected size:sigma, both > 0 [px])");
+		if (!t.empty() && !(size > t.back().first))
+			throw std::invalid_argument(
+				"sigma table: sizes must increase, '" + entry + "' does not");
+		t.emplace_back(size, sigma);
+	}
+	return t;
+}
+
+std::string toString(const SigmaTable& t)
+{
+	std::ostringstream s;
+	for (size_t k = 0; k < t.size(); ++k) s << (k ? " " : "") << t[k].first << ":" << t[k].second;
+	return s.str();
+}
+
 void PoseOptions::validate() const
 {
 	if (!(sigma_px > 0) || !std::isfinite(sigma_px))
@@ -71,10 +121,22 @@ void PoseOptions::validate() const
 		if (!(std::abs(r) < 1))
 			throw std::invalid_argument(
 				"pose options: the correlations corr_* must lie in (-1, 1)");
+	if (!(clipped_side_correlation >= 0) || !(clipped_side_correlation < 1))
+		throw std::invalid_argument("pose options: clipped_side_correlation must lie in [0, 1)");
+	if (!(aligned_edge_ratio >= 0) || !std::isfinite(aligned_edge_ratio))
+		throw std::invalid_argument("pose options: aligned_edge_ratio must be finite and >= 0");
+	if (!(clipped_side_sigma_px >= 0) || !std::isfinite(clipped_side_sigma_px))
+		throw std::invalid_argument("pose options: clipped_side_sigma_px must be finite and >= 0");
 	if (!(corner_midpoint_ratio > 0) || !(corner_tilt_ratio > 0) ||
 		!std::isfinite(corner_midpoint_ratio) || !std::isfinite(corner_tilt_ratio))
 		throw std::invalid_argument(
 			"pose options: corner_midpoint_ratio, corner_tilt_ratio must be finite and > 0");
+	for (const SigmaTable* t : {&sigma_x_table, &sigma_y_table})
+		for (size_t k = 0; k < t->size(); ++k)
+			if (!((*t)[k].first > 0) || !((*t)[k].second > 0) || !std::isfinite((*t)[k].second) ||
+				(k > 0 && !((*t)[k].first > (*t)[k - 1].first)))
+				throw std::invalid_argument(
+					"pose options: sigma tables need sizes increasing and sigmas > 0");
 	if (lm_max_iterations < 1)
 		throw std::invalid_argument("pose options: lm_max_iterations must be >= 1");
 }
@@ -87,6 +149,10 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	sigma_source = sigmaSourceFromString(c.read_string(s, "sigma_source", toString(sigma_source)));
 	MRPT_LOAD_CONFIG_VAR(growth_x_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(growth_y_px, double, c, s);
+	sigma_x_table =
+		sigmaTableFromString(c.read_string(s, "sigma_x_table", toString(sigma_x_table)));
+	sigma_y_table =
+		sigmaTableFromString(c.read_string(s, "sigma_y_table", toString(sigma_y_table)));
 	MRPT_LOAD_CONFIG_VAR(size_exponent_x, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_y, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_reference_px, double, c, s);
@@ -94,6 +160,9 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(corr_y12, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corr_growth_x12, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corr_growth_y12, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(clipped_side_sigma_px, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(clipped_side_correlation, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(aligned_edge_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corner_midpoint_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corner_tilt_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(second_order_pose_covariance, bool, c, s);
@@ -121,6 +190,12 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 		s, "growth_y_px", growth_y_px, -1, -1,
 		"growth of sigma(y1, y2) for small landmarks [px]; 0: constant");
 	c.write(
+		s, "sigma_x_table", toString(sigma_x_table), -1, -1,
+		"size:sigma pairs [px] of x1, x2 against x2 - x1; replace sigma_px and growth_x_px");
+	c.write(
+		s, "sigma_y_table", toString(sigma_y_table), -1, -1,
+		"size:sigma pairs [px] of y1, y2 against y1 + y2; replace sigma_y_px and growth_y_px");
+	c.write(
 		s, "size_exponent_x", size_exponent_x, -1, -1,
 		"sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
 	c.write(
@@ -133,6 +208,15 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(
 		s, "corr_y12", corr_y12, -1, -1, "correlation of the errors of y1 and y2, constant part");
 	c.write(s, "corr_growth_y12", corr_growth_y12, -1, -1, "the same, size-dependent part");
+	c.write(
+		s, "clipped_side_sigma_px", clipped_side_sigma_px, -1, -1,
+		"std. dev. added to a side whose fill clips throughout [px]; 0: off");
+	c.write(
+		s, "clipped_side_correlation", clipped_side_correlation, -1, -1,
+		"correlation of two clipped sides' outward shifts (0..1)");
+	c.write(
+		s, "aligned_edge_ratio", aligned_edge_ratio, -1, -1,
+		"extra sigma of a top/bottom edge along a pixel row, over sigma(y_i); 0: off");
 	c.write(
 		s, "corner_midpoint_ratio", corner_midpoint_ratio, -1, -1,
 		"General6Dof: sigma of an edge's midpoint height over sigma(y_i)");
@@ -165,19 +249,77 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(const Eigen::Vector4d& P) const
 	Eigen::Matrix4d C = Eigen::Vector4d(vx, vy, vx, vy).asDiagonal();
 	C(0, 2) = C(2, 0) = corr_x12 * fx2 + corr_growth_x12 * gx * gx;
 	C(1, 3) = C(3, 1) = corr_y12 * fy2 + corr_growth_y12 * gy * gy;
+	if (!sigma_x_table.empty())
+	{
+		const double v = std::pow(interpolateSigma(sigma_x_table, w), 2);
+		C(0, 0) = C(2, 2) = v;
+		C(0, 2) = C(2, 0) = corr_growth_x12 * v;
+	}
+	if (!sigma_y_table.empty())
+	{
+		const double v = std::pow(interpolateSigma(sigma_y_table, h), 2);
+		C(1, 1) = C(3, 3) = v;
+		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
+	}
 	return C;
 }
 
-Measurement measure(
+Eigen::Matrix4d PoseOptions::clippedSidesCovariance(const std::array<bool, 4>& clipped) const
+{
+	// P's change per unit outward shift of each side (top, right, bottom,
+	// left): a top or bottom shift d lengthens both vertical edges by d,
+	// each half-length by d / 2.
+	Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+	A(1, 0) = A(3, 0) = 0.5;  // top
+	A(2, 1) = 1;  // right: x2
+	A(1, 2) = A(3, 2) = 0.5;  // bottom
+	A(0, 3) = -1;  // left: x1
+	const double v = clipped_side_sigma_px * clipped_side_sigma_px;
+	Eigen::Matrix4d S = Eigen::Matrix4d::Zero();  // the clipped sides' shifts
+	for (int a = 0; a < 4; ++a)
+		for (int b = 0; b < 4; ++b)
+			if (clipped[a] && clipped[b]) S(a, b) = a == b ? v : clipped_side_correlation * v;
+	return A * S * A.transpose();
+}
+
+Eigen::Matrix4d PoseOptions::alignedEdgesCovariance(
+	const Eigen::Vector4d& P, double top_rows, double bottom_rows) const
+{
+	Eigen::Matrix4d C = Eigen::Matrix4d::Zero();
+	if (aligned_edge_ratio <= 0) return C;
+	// sigma_y(h) of the y model (without its correlation).
+	PoseOptions plain = *this;
+	plain.corr_y12 = plain.corr_growth_y12 = 0;
+	const double vy = plain.primaryCovariance(P)(1, 1);
+	const auto weight = [](double rows) { return std::max(0.0, 1 - std::abs(rows)); };
+	// Each aligned edge's shift d moves y1 and y2 by d / 2.
+	const double h = 0.25 * aligned_edge_ratio * aligned_edge_ratio * vy *
+					 (weight(top_rows) + weight(bottom_rows));
+	C(1, 1) = C(3, 3) = C(1, 3) = C(3, 1) = h;
+	return C;
+}
+
+namespace
+{
+Measurement measureWith(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
-	const LandmarkGeometry& geometry, const PoseOptions& options)
+	const LandmarkGeometry& geometry, const PoseOptions& options,
+	const std::array<bool, 4>& clipped)
 {
 	options.validate();
 	Measurement m;
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	m.C_P = options.primaryCovariance(m.P);
+	m.C_P = options.primaryCovariance(m.P) + options.clippedSidesCovariance(clipped);
+	if (options.aligned_edge_ratio > 0)
+	{
+		// Rows between the ends of the top (TL, TR) and bottom (BL, BR) edges.
+		std::array<Eigen::Vector2d, 4> ideal;
+		for (int k = 0; k < 4; ++k) ideal[k] = camera.undistortPixel(corners[k]);
+		m.C_P += options.alignedEdgesCovariance(
+			m.P, ideal[1].y() - ideal[0].y(), ideal[2].y() - ideal[3].y());
+	}
 	if (options.method == PoseMethod::ClosedForm)
 	{
 		Eigen::Matrix<double, 3, 4> J_P;
@@ -216,6 +358,14 @@ Measurement measure(
 	m.ambiguity_ratio = g.ambiguity_ratio;
 	return m;
 }
+}  // namespace
+
+Measurement measure(
+	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
+	const LandmarkGeometry& geometry, const PoseOptions& options)
+{
+	return measureWith(corners, camera, geometry, options, {{false, false, false, false}});
+}
 
 Measurement measure(
 	const Detection& detection, const CameraModel& camera, const LandmarkGeometry& geometry,
@@ -229,7 +379,7 @@ Measurement measure(
 		o.growth_x_px = o.growth_y_px = 0;
 		o.corr_x12 = o.corr_y12 = 0;
 	}
-	return measure(detection.corners, camera, geometry, o);
+	return measureWith(detection.corners, camera, geometry, o, detection.quality.fill_clipped);
 }
 
 }  // namespace codemark::pose

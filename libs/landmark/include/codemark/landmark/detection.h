@@ -27,6 +27,11 @@ struct DetectionQuality
 	/** Standard deviation of each corner coordinate estimated from the line
 	 * fits [px]; 0 when not estimated. */
 	double corner_sigma_px = 0;
+	/** Per side (top, right, bottom, left): the green fill clipped at the
+	 * sensor's top along all of it, so the edge rests on the dark half of
+	 * its transition only (restored from an edge model where it fits): it
+	 * is less certain (pose::PoseOptions::clipped_side_sigma_px). */
+	std::array<bool, 4> fill_clipped{{false, false, false, false}};
 };
 
 /** One detected landmark. */

@@ -14,6 +14,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace codemark::pose
 {
@@ -62,6 +64,20 @@ PoseMethod poseMethodFromString(const std::string& name);
  * runs the detector uses. */
 constexpr double kDefaultSigmaPx = 0.05;
 
+/** A standard deviation tabulated against an apparent size: (size [px],
+ * sigma [px]) pairs, sizes increasing. */
+using SigmaTable = std::vector<std::pair<double, double>>;
+
+/** sigma at \a size_px: linear in log(size) - log(sigma) between the
+ * entries, the end values beyond them. \a table must not be empty. */
+double interpolateSigma(const SigmaTable& table, double size_px);
+
+/** "size:sigma size:sigma ..." (the ini form); throws std::invalid_argument
+ * naming the bad entry on anything else, on sizes not increasing or on
+ * values that are not finite and > 0. An empty text is an empty table. */
+SigmaTable sigmaTableFromString(const std::string& text);
+std::string toString(const SigmaTable& table);
+
 /** Options of measure(). Loadable from an ini section. */
 struct PoseOptions : public mrpt::config::CLoadableOptions
 {
@@ -89,6 +105,17 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double growth_x_px = 0;
 	/** The same for y1, y2 with h = y1 + y2 the apparent height [px]. */
 	double growth_y_px = 0;
+	/** When not empty: sigma(x1) = sigma(x2) tabulated against the apparent
+	 * width w = x2 - x1 (interpolateSigma()), in place of sigma_px and the
+	 * growth term, and corr(x1, x2) = corr_growth_x12 throughout. A
+	 * detector's error against size need not follow one power law (a thin
+	 * frame's edges pull on each other below about 7 px, noise alone
+	 * falls as 1 / sqrt(edge length)): codemark-bench-pose-calib measures the
+	 * table. ini key `sigma_x_table` = "size:sigma size:sigma ...". */
+	SigmaTable sigma_x_table;
+	/** The same for y1, y2 against the apparent height h = y1 + y2, with
+	 * corr_growth_y12. ini key `sigma_y_table`. */
+	SigmaTable sigma_y_table;
 	double size_exponent_x = 2;	 //!< exponent of the growth of x1, x2 (see growth_x_px)
 	double size_exponent_y = 2;	 //!< exponent of the growth of y1, y2 (see growth_x_px)
 	double size_reference_px =
@@ -116,6 +143,40 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * noise. ini keys `corner_midpoint_ratio`, `corner_tilt_ratio`. */
 	double corner_midpoint_ratio = 1.0;
 	double corner_tilt_ratio = 1.0;	 //!< see corner_midpoint_ratio
+	/** Standard deviation added to the edge of each side whose green fill
+	 * clipped throughout (DetectionQuality::fill_clipped) [px]: its edge
+	 * rests on the dark half of the transition alone, 2-5x less certain than
+	 * an unclipped one within 2 m (docs/benchmarks/pose.md). A left or right
+	 * side adds it to x1 or x2; a top or bottom side moves both half-lengths
+	 * by half its shift (y1, y2 fully correlated). Applied by
+	 * measure(const Detection&, ...) only (a prediction cannot know the
+	 * light). 0: off. ini key `clipped_side_sigma_px`. */
+	double clipped_side_sigma_px = 0;
+	/** Correlation (0..1) of the outward shifts of two clipped sides: the
+	 * edge model's fill level, which places every clipped edge, errs for all
+	 * of them at once, so a landmark clipped all round looks larger or
+	 * smaller as a whole (a range error). ini key
+	 * `clipped_side_correlation`. */
+	double clipped_side_correlation = 0;
+	/** The part of C_P that clipped sides add (see clipped_side_sigma_px),
+	 * sides in the order top, right, bottom, left. */
+	Eigen::Matrix4d clippedSidesCovariance(const std::array<bool, 4>& clipped) const;
+	/** A top or bottom edge that runs along a pixel row (its ends less than
+	 * a row apart in the image: a level camera at the landmark's height)
+	 * keeps one sub-pixel phase over its length, so the edge estimator's
+	 * phase-dependent bias does not average out along it; tilted by a row or
+	 * more, it does. Such an edge's offset gets the extra standard deviation
+	 * aligned_edge_ratio sigma_y(h) (1 - rows), rows the ends' difference
+	 * [px] (0 beyond one row), shared by y1 and y2 as a clipped side's.
+	 * (Vertical edges of a level camera always run along a pixel column:
+	 * the calibration's x model holds that.) 0: off. ini key
+	 * `aligned_edge_ratio`. */
+	double aligned_edge_ratio = 0;
+	/** The part of C_P that aligned top and bottom edges add (see
+	 * aligned_edge_ratio), from the ends' row differences [px] of the top
+	 * and bottom edges. */
+	Eigen::Matrix4d alignedEdgesCovariance(
+		const Eigen::Vector4d& P, double top_rows_px, double bottom_rows_px) const;
 	/** C_P of a measured or predicted P under these options (without the
 	 * detector's own sigma), the sum of a constant and a size-dependent part,
 	 * each with its correlation of the two edges:
