@@ -32,12 +32,12 @@ if [[ $quick -eq 1 ]]; then
 fi
 echo "== C_P calibration (realistic scenes, as the shipped values)"
 "$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance
-echo "== C_P calibration (the accuracy map's flat background, for comparison)"
-"$calib" --renders 3000 --seed 7
+echo "== C_P calibration (the accuracy map's flat background: its C_P, plainBackgroundPoseOptions)"
+"$calib" --renders 3000 --seed 7 --uniform-distance
 echo "== accuracy map"
 "$map" --out apps/codemark-accuracy-map/results --renders 10
-echo "== accuracy map with the C_P calibrated on its own plain background (the NEES check)"
-"$map" --out apps/codemark-accuracy-map/results/plain-calibration --renders 10 --no-apriltag --calibration plain
+echo "== accuracy map with the shipped C_P of the textured, lit scenes (for comparison)"
+"$map" --out apps/codemark-accuracy-map/results/realistic-calibration --renders 10 --no-apriltag --calibration realistic
 "$build_dir/apps/codemark-uncertainty/codemark-uncertainty" --out apps/codemark-uncertainty/results/fig3.png
 mkdir -p docs/images
 for f in heat_l2 heat_phi2 heat_x heat_y; do

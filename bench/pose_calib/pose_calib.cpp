@@ -33,6 +33,14 @@ using namespace codemark;
 
 namespace
 {
+/** -2 log-likelihood (up to a constant) of the error pair (e1, e2) under
+ * variances v1, v2 and covariance c. */
+double pairNll(double e1, double e2, double v1, double v2, double c)
+{
+	const double det = v1 * v2 - c * c;
+	return (v2 * e1 * e1 - 2 * c * e1 * e2 + v1 * e2 * e2) / det + std::log(det);
+}
+
 struct Sample
 {
 	double d, angle_deg;
@@ -303,10 +311,7 @@ int main(int argc, char** argv)
 						// A clipped top or bottom moves y1 and y2 together.
 						const double c = rf * f.floor * f.floor + rg * g * g +
 										 (x ? 0.0 : 0.25 * s.clippedOn(1) * f.clip * f.clip);
-						const double det = v1 * v2 - c * c;
-						const double e1 = s.e_P[c1], e2 = s.e_P[c2];
-						nll +=
-							(v2 * e1 * e1 - 2 * c * e1 * e2 + v1 * e2 * e2) / det + std::log(det);
+						nll += pairNll(s.e_P[c1], s.e_P[c2], v1, v2, c);
 					}
 					if (nll < best)
 					{
@@ -440,11 +445,9 @@ int main(int argc, char** argv)
 					for (const auto& s : samples)
 					{
 						const double t2 = std::pow(pose::interpolateSigma(ty, s.side_px), 2);
-						const double v = var(s, 1), c = aligned(s, 1) * t2 + share(s, 1) - 0.0;
+						const double v = var(s, 1), c = aligned(s, 1) * t2 + share(s, 1);
 						// y1, y2 share the aligned and clipped shifts.
-						const double det = v * v - c * c;
-						const double e1 = s.e_P[1], e2 = s.e_P[3];
-						nll += (v * e1 * e1 - 2 * c * e1 * e2 + v * e2 * e2) / det + std::log(det);
+						nll += pairNll(s.e_P[1], s.e_P[3], v, v, c);
 					}
 					if (nll < best)
 					{
@@ -469,10 +472,7 @@ int main(int argc, char** argv)
 						const double t2 =
 							std::pow(pose::interpolateSigma(x ? tx : ty, sizeOf(s, x)), 2);
 						const double c = r * t2 + (x ? 0.0 : share(s, 1) + aligned(s, 1) * t2);
-						const double det = v1 * v2 - c * c;
-						const double e1 = s.e_P[c1], e2 = s.e_P[c2];
-						nll +=
-							(v2 * e1 * e1 - 2 * c * e1 * e2 + v1 * e2 * e2) / det + std::log(det);
+						nll += pairNll(s.e_P[c1], s.e_P[c2], v1, v2, c);
 					}
 					if (nll < best)
 					{

@@ -32,6 +32,27 @@ std::pair<double, double> poseError(const CPose3D& a, const CPose3D& b)
 	return {ang, (a.translation() - b.translation()).norm()};
 }
 
+// (L, pose_in_landmark) of \a gp minus that of \a ref, angles wrapped.
+Eigen::Matrix<double, 6, 1> errorOf(const GeneralPose& gp, const GeneralPose& ref)
+{
+	Eigen::Matrix<double, 6, 1> x;
+	x << gp.L - ref.L, gp.pose_in_landmark - ref.pose_in_landmark;
+	x[2] = wrapToPi(x[2]);
+	x[5] = wrapToPi(x[5]);
+	return x;
+}
+
+// The sample covariance of (L, pose_in_landmark) errors.
+Eigen::Matrix<double, 6, 6> sampleCovariance(const std::vector<Eigen::Matrix<double, 6, 1>>& v)
+{
+	const double N = static_cast<double>(v.size());
+	Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+	for (const auto& x : v) mean += x / N;
+	Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+	for (const auto& x : v) C += (x - mean) * (x - mean).transpose() / (N - 1);
+	return C;
+}
+
 CameraModel distortedCamera()
 {
 	mrpt::img::TCamera p;
@@ -237,16 +258,9 @@ TEST(General, CovarianceMatchesMonteCarlo)
 		auto c = corners;
 		for (auto& p : c) p += Eigen::Vector2d(n(rng), n(rng));
 		const GeneralPose gp = solveGeneralPose(c, cam, g, sigma_c);
-		Eigen::Matrix<double, 6, 1> x;
-		x << gp.L - ref.L, gp.pose_in_landmark - ref.pose_in_landmark;
-		x[2] = wrapToPi(x[2]);
-		x[5] = wrapToPi(x[5]);
-		v.push_back(x);
+		v.push_back(errorOf(gp, ref));
 	}
-	Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
-	for (const auto& x : v) mean += x / N;
-	Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-	for (const auto& x : v) C += (x - mean) * (x - mean).transpose() / (N - 1);
+	const Eigen::Matrix<double, 6, 6> C = sampleCovariance(v);
 	const Eigen::Matrix3d CL = C.topLeftCorner<3, 3>(), CR = C.bottomRightCorner<3, 3>();
 	EXPECT_LT((CL - ref.C_L).norm() / ref.C_L.norm(), 0.15);
 	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.15);
@@ -309,16 +323,9 @@ TEST(General, CorrelatedCornerCovarianceMatchesMonteCarlo)
 		auto c = corners;
 		for (int k = 0; k < 4; ++k) c[k] += e.segment<2>(2 * k);
 		const GeneralPose gp = solveGeneralPose(c, cam, g, Cc);
-		Eigen::Matrix<double, 6, 1> x;
-		x << gp.L - ref.L, gp.pose_in_landmark - ref.pose_in_landmark;
-		x[2] = wrapToPi(x[2]);
-		x[5] = wrapToPi(x[5]);
-		v.push_back(x);
+		v.push_back(errorOf(gp, ref));
 	}
-	Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
-	for (const auto& x : v) mean += x / N;
-	Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
-	for (const auto& x : v) C += (x - mean) * (x - mean).transpose() / (N - 1);
+	const Eigen::Matrix<double, 6, 6> C = sampleCovariance(v);
 	const Eigen::Matrix3d CL = C.topLeftCorner<3, 3>(), CR = C.bottomRightCorner<3, 3>();
 	EXPECT_LT((CL - ref.C_L).norm() / ref.C_L.norm(), 0.1);
 	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.1);
