@@ -522,7 +522,8 @@ std::string writeResults(
 	  << (o.realistic ? "realistic scene (textured wall, light gradient, distractors)"
 					  : "plain background")
 	  << ", closed form " << (o.pose.refine_on_primary ? "refined on P" : "paper's formulas alone")
-	  << "\n";
+	  << ", each render aimed off the landmark by up to " << fmt(o.aim_jitter_rad, 2) << " rad and "
+	  << fmt(o.height_jitter_m, 2) << " m in height\n";
 	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general "
 		 "6-DoF,"
 		 " tag = AprilTag 3 tag36h11 (same corner square) + general path (its NEES uses codemark's "

@@ -73,6 +73,17 @@ int main(int argc, char** argv)
 			"(the AprilTag renders keep theirs; use with --no-apriltag for a like-for-like "
 			"comparison).",
 			cmd, false);
+		TCLAP::ValueArg<double> aim_arg(
+			"", "aim-jitter",
+			"Each render aims the camera off the landmark by a bearing drawn within +-RAD (a "
+			"landmark dead centre in the image mirrors its edges' pixel phases, whose biases then "
+			"cancel). 0 with --height-jitter 0: exactly centred. Default 0.15.",
+			false, 0.15, "RAD", cmd);
+		TCLAP::ValueArg<double> height_arg(
+			"", "height-jitter",
+			"Each render puts the camera up to M above or below the landmark's centre. Default "
+			"0.2.",
+			false, 0.2, "M", cmd);
 		TCLAP::SwitchArg no_tag_arg("", "no-apriltag", "Skip the AprilTag comparison.", cmd, false);
 		TCLAP::ValueArg<unsigned long> seed_arg(
 			"", "seed", "First render seed. Default 1.", false, 1, "N", cmd);
@@ -112,6 +123,12 @@ int main(int argc, char** argv)
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
 			o.noise_label = "the detector's per-detection corner sigma";
 		o.seed = seed_arg.getValue();
+		o.aim_jitter_rad = aim_arg.getValue();
+		o.height_jitter_m = height_arg.getValue();
+		if (!(o.aim_jitter_rad >= 0 && o.aim_jitter_rad < 0.5) ||
+			!(o.height_jitter_m >= 0 && o.height_jitter_m < 2))
+			throw std::invalid_argument(
+				"--aim-jitter must lie in [0, 0.5) rad and --height-jitter in [0, 2) m");
 		if (o.renders_per_cell < 1 || !(o.cell_m > 0) || !(o.max_distance_m > 0) ||
 			!(o.pose.sigma_px > 0) || o.noise_sigma < 0 || o.blur_sigma_px < 0)
 			throw std::invalid_argument(
