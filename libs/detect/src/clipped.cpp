@@ -189,15 +189,11 @@ double inverseNormalCdf(double q)
 	return z;
 }
 
-/** A level constant over the band: from where the clip cuts its samples'
+/** A level constant over the band, from where the clip cuts its samples'
  * distribution and their unclipped median (a censored normal; robust to the
- * few samples of the neighbouring edges' blur that the band holds), every
- * sample at 255 gets the expectation of a sample above the clip. */
-struct ConstantFill
-{
-	double mu, sigma;
-};
-std::optional<ConstantFill> constantFill(const ClippedFill& f)
+ * few samples of the neighbouring edges' blur, or a JPEG's ringing, that
+ * the band holds). */
+std::optional<FillLevel> constantFill(const ClippedFill& f, int m, int i0, int i1)
 {
 	if (f.unclipped < 10 || f.clipped < 10) return std::nullopt;
 	// 254.5 is the (1 - p_c) quantile of a censored normal, the unclipped
@@ -209,19 +205,39 @@ std::optional<ConstantFill> constantFill(const ClippedFill& f)
 	const double z_c = inverseNormalCdf(1 - p_c), z_m = inverseNormalCdf(0.5 * (1 - p_c));
 	const double sigma = (254.5 - median) / (z_c - z_m);
 	if (!(sigma > 0.1) || !std::isfinite(sigma)) return std::nullopt;
-	return ConstantFill{254.5 - sigma * z_c, sigma};
+	FillLevel l;
+	l.beta = Eigen::Vector3d(254.5 - sigma * z_c, 0, 0);
+	l.sigma = sigma;
+	l.profiles = m;
+	l.i0 = i0;
+	l.i1 = i1;
+	return l;
 }
 
-void imputeConstantFill(std::vector<int>& g_profiles, const ConstantFill& cf)
+/** The clipped fraction of each quarter of the side and of each half across
+ * it agrees with the band's within 3 binomial sigmas: a level flat enough
+ * for constantFill(), decided without the regression (about 0.5 ms a side;
+ * a fill at about the top without a light gradient, the common case, does
+ * not need it). */
+bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int i1, double p)
 {
-	const double mu = cf.mu, sigma = cf.sigma, z_c = (254.5 - mu) / sigma;
-	// E[v | v >= 254.5] = mu + sigma phi(z_c) / (1 - Phi(z_c)); every sample
-	// at the top is the fill's (the white margin, the frame and the code
-	// cells lie far below it when the fill is about at the top).
-	const int imputed =
-		static_cast<int>(std::lround(mu + sigma * phi(z_c) / std::max(1e-12, 1 - Phi(z_c))));
-	for (int& v : g_profiles)
-		if (v >= 255) v = imputed;
+	std::array<int, 6> n_part{}, c_part{};	// 4 quarters along, 2 halves across
+	const int i_mid = (i0 + i1) / 2;
+	for (int j = 0; j < m; ++j)
+		for (int i = i0; i <= i1; ++i)
+		{
+			const bool cl = g_profiles[j * n + i] >= 255;
+			const int q = std::min(3, 4 * j / m), h = 4 + (i > i_mid);
+			++n_part[q];
+			++n_part[h];
+			c_part[q] += cl;
+			c_part[h] += cl;
+		}
+	for (int k = 0; k < 6; ++k)
+		if (n_part[k] > 0 && std::abs(double(c_part[k]) / n_part[k] - p) >
+								 3 * std::sqrt(std::max(1e-4, p * (1 - p)) / n_part[k]))
+			return false;
+	return true;
 }
 }  // namespace
 
@@ -246,10 +262,30 @@ ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i
 	return f;
 }
 
-bool imputeClippedFill(
-	std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill, bool* fill_above)
+Eigen::Vector3d FillLevel::design(int j, int i) const
 {
-	if (fill_above) *fill_above = false;
+	const double s = profiles > 1 ? 2.0 * j / (profiles - 1) - 1 : 0;
+	const double t = i1 > i0 ? 2.0 * (std::clamp(i, i0, i1) - i0) / (i1 - i0) - 1 : 0;
+	return {1, s, t};
+}
+
+bool FillLevel::aboveClip() const
+{
+	double top = -1e300;
+	for (const int j : {0, profiles - 1})
+		for (const int i : {i0, i1}) top = std::max(top, design(j, i).dot(beta));
+	return top > 254.5 + std::max(sigma, 0.02 * 254.5);
+}
+
+std::optional<FillLevel> fitFillLevel(
+	const std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill)
+{
+	i0 = std::max(0, i0);
+	i1 = std::min(n - 1, i1);
+	const int m = static_cast<int>(g_profiles.size()) / n;
+	if (i1 < i0 || m < 2) return std::nullopt;
+	if (clippedEvenly(g_profiles, n, m, i0, i1, fill.fraction()))
+		return constantFill(fill, m, i0, i1);
 	// Censored (Tobit) regression of the band's samples on (1, along,
 	// across), both normalised to [-1, 1]: a light gradient makes the
 	// fill's level vary along a side (a top edge clipped at one end only)
@@ -257,54 +293,11 @@ bool imputeClippedFill(
 	// px errors (gradient 0.3 across the image within 2 m). Olsen's
 	// parametrisation (gamma = beta / sigma, tau = 1 / sigma) makes the
 	// log-likelihood concave: Newton with step halving.
-	i0 = std::max(0, i0);
-	i1 = std::min(n - 1, i1);
-	const int m = static_cast<int>(g_profiles.size()) / n;
-	if (i1 < i0 || m < 2) return false;
 	constexpr double c = 254.5;
-	const auto design = [&](int j, int i)
-	{
-		const double s = m > 1 ? 2.0 * j / (m - 1) - 1 : 0;
-		const double t = i1 > i0 ? 2.0 * (std::clamp(i, i0, i1) - i0) / (i1 - i0) - 1 : 0;
-		return Eigen::Vector3d(1, s, t);
-	};
-	// A flat level first, cheaply: the clipped fraction of each quarter of
-	// the side and of each half across it agrees with the band's within 3
-	// binomial sigmas (the regression below costs about 0.5 ms a side, and a
-	// fill at about the top without a light gradient, the common case, does
-	// not need it).
-	{
-		const double p = fill.fraction();
-		std::array<int, 6> n_part{}, c_part{};	// 4 quarters along, 2 halves across
-		const int i_mid = (i0 + i1) / 2;
-		for (int j = 0; j < m; ++j)
-			for (int i = i0; i <= i1; ++i)
-			{
-				const bool cl = g_profiles[j * n + i] >= 255;
-				const int q = std::min(3, 4 * j / m), h = 4 + (i > i_mid);
-				++n_part[q];
-				++n_part[h];
-				c_part[q] += cl;
-				c_part[h] += cl;
-			}
-		bool flat = true;
-		for (int k = 0; k < 6 && flat; ++k)
-			if (n_part[k] > 0)
-				flat = std::abs(double(c_part[k]) / n_part[k] - p) <=
-					   3 * std::sqrt(std::max(1e-4, p * (1 - p)) / n_part[k]);
-		if (flat)
-		{
-			const auto constant = constantFill(fill);
-			if (!constant) return false;
-			if (constant->mu > c + std::max(constant->sigma, 0.02 * c) && fill_above)
-			{
-				*fill_above = true;
-				return false;
-			}
-			imputeConstantFill(g_profiles, *constant);
-			return true;
-		}
-	}
+	FillLevel level;
+	level.profiles = m;
+	level.i0 = i0;
+	level.i1 = i1;
 	// Start: least squares on the unclipped samples.
 	Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
 	Eigen::Vector3d bv = Eigen::Vector3d::Zero();
@@ -319,18 +312,18 @@ bool imputeClippedFill(
 				continue;
 			}
 			++unclipped;
-			const Eigen::Vector3d x = design(j, i);
+			const Eigen::Vector3d x = level.design(j, i);
 			A += x * x.transpose();
 			bv += v * x;
 		}
-	if (unclipped < 10 || clipped < 10) return false;
+	if (unclipped < 10 || clipped < 10) return std::nullopt;
 	Eigen::Vector3d beta = (A + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(bv);
 	double ss = 0;
 	for (int j = 0; j < m; ++j)
 		for (int i = i0; i <= i1; ++i)
 		{
 			const int v = g_profiles[j * n + i];
-			if (v < 255) ss += std::pow(v - design(j, i).dot(beta), 2);
+			if (v < 255) ss += std::pow(v - level.design(j, i).dot(beta), 2);
 		}
 	const double sigma0 = std::max(0.5, std::sqrt(ss / unclipped));
 	Eigen::Vector4d th;	 // gamma (3), tau
@@ -346,7 +339,7 @@ bool imputeClippedFill(
 			for (int i = i0; i <= i1; ++i)
 			{
 				const int v = g_profiles[j * n + i];
-				const Eigen::Vector3d x = design(j, i);
+				const Eigen::Vector3d x = level.design(j, i);
 				Eigen::Vector4d dz;	 // d(residual or z)/d(gamma, tau)
 				if (v < 255)
 				{
@@ -387,7 +380,7 @@ bool imputeClippedFill(
 		Eigen::Matrix4d H;
 		logLik(th, &g, &H);
 		const Eigen::Vector4d step = (-H).ldlt().solve(g);
-		if (!step.allFinite()) return false;
+		if (!step.allFinite()) return std::nullopt;
 		double scale = 1;
 		for (; scale > 1e-4; scale *= 0.5)
 		{
@@ -404,52 +397,35 @@ bool imputeClippedFill(
 		}
 		if (scale <= 1e-4) converged = true;  // no ascent left: at the maximum
 	}
-	const double sigma = 1 / th[3];
-	beta = th.head<3>() * sigma;
-	if (!(sigma > 0.1 && sigma < 50) || !beta.allFinite()) return false;
-	// A fill above the clip by more than its noise and 2% somewhere clips
-	// the bright part of its edges' transitions too (their top 2% and more),
-	// whose samples lie below the fill's level: not this model's case
-	// (imputeClippedSide()'s). Less than that cuts too little of a
-	// transition to move an edge (and a JPEG's smoothed noise would make
-	// any fill at the top look above it).
-	// A level constant to within the noise: the constant model's robust
-	// estimate (a regression's least squares would take the band's few
-	// samples of neighbouring blur, or a JPEG's ringing, at face value).
-	const bool flat = std::abs(beta[1]) + std::abs(beta[2]) < sigma;
-	const auto constant = flat ? constantFill(fill) : std::nullopt;
-	if (flat && !constant) return false;
-	double top = -1e300;
-	if (constant)
-		top = constant->mu;
-	else
-		for (const int j : {0, m - 1})
-			for (const int i : {i0, i1}) top = std::max(top, design(j, i).dot(beta));
-	if (top > c + std::max(sigma, 0.02 * c) && fill_above)
-	{
-		*fill_above = true;
-		return false;
-	}
-	if (constant)
-	{
-		imputeConstantFill(g_profiles, *constant);
-		return true;
-	}
+	level.sigma = 1 / th[3];
+	level.beta = th.head<3>() * level.sigma;
+	if (!(level.sigma > 0.1 && level.sigma < 50) || !level.beta.allFinite()) return std::nullopt;
+	// A level constant to within the noise after all: the constant model's
+	// robust estimate (a regression's least squares would take the band's
+	// few samples of neighbouring blur, or a JPEG's ringing, at face value).
+	if (std::abs(level.beta[1]) + std::abs(level.beta[2]) < level.sigma)
+		return constantFill(fill, m, i0, i1);
+	return level;
+}
+
+void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level)
+{
 	// Every sample at the top gets E[v | v >= 254.5] of its place's fill
 	// (the white margin, the frame and the code cells lie far below it when
 	// the fill is about at the top).
+	constexpr double c = 254.5;
+	const int m = static_cast<int>(g_profiles.size()) / n;
 	for (int j = 0; j < m; ++j)
 		for (int i = 0; i < n; ++i)
 		{
 			int& v = g_profiles[j * n + i];
 			if (v < 255) continue;
-			const double mu = design(j, i).dot(beta), z = (c - mu) / sigma;
+			const double mu = level.design(j, i).dot(level.beta), z = (c - mu) / level.sigma;
 			const double tail = Phi(-z);
-			const double e =
-				tail > 1e-12 ? mu + sigma * phi(z) / tail : c + sigma / std::max(1.0, z);
+			const double e = tail > 1e-12 ? mu + level.sigma * phi(z) / tail
+										  : c + level.sigma / std::max(1.0, z);
 			v = static_cast<int>(std::lround(std::max(c, e)));
 		}
-	return true;
 }
 
 double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)

@@ -179,7 +179,7 @@ struct ClippedSideProfiles
  * peak and centroid outwards (the square looks larger): by 0.012 px where
  * only the noise of a fill at exactly 255 clips, 0.05 px at gains of
  * 1.1-1.6 within 2 m and up to 0.5 px on 4-5 px frames.
- * Where part of the fill band is unclipped, imputeClippedFill() does it
+ * Where part of the fill band is unclipped, imputeFillLevel() does it
  * before the edges are first located. Where all of it clips: a Gaussian-blurred, pixel-integrated
  * step (with the frame's outer edge below 7 px) in B, G and R, the side's blur and levels shared
  * and the edge a quadratic along the side, is fitted by maximum likelihood with the samples at 255
@@ -208,22 +208,37 @@ struct ClippedFill
 };
 ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1);
 
-/** Where part of a fill band is unclipped, only its noise clips: every
- * sample at 255 of \a g_profiles gets the expectation of a sample above the
- * clip at its place. The fill's level, linear along and across the side (a
- * light gradient), and its noise follow by censored (Tobit) regression of
- * the band's samples (profile indices i0..i1 of each \a n-sample profile,
- * \a fill their tally); where the level is constant to within the noise,
- * from \a fill's median and clipped fraction (a censored normal, robust to
- * the band's few samples of neighbouring blur). False (nothing changed)
- * with under 10 samples on either side, without convergence, or where the
- * level lies above the clip by more than the noise somewhere in the band
- * (\a fill_above then true): there the edges' transitions clip too,
- * imputeClippedSide()'s case. Without \a fill_above it imputes there too
- * (the fallback where that model is refused). */
-bool imputeClippedFill(
-	std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill,
-	bool* fill_above = nullptr);
+/** The G level of a side's fill band where part of it is unclipped: linear
+ * along and across the side (a light gradient), beta . (1, along, across)
+ * with both coordinates normalised to [-1, 1] over the band's profiles and
+ * sample indices i0..i1, and the noise sigma [grey levels]. */
+struct FillLevel
+{
+	Eigen::Vector3d beta = Eigen::Vector3d::Zero();
+	double sigma = 0;
+	int profiles = 0, i0 = 0, i1 = 0;
+	/** (1, along, across) of sample i of profile j (across clamped to the band). */
+	Eigen::Vector3d design(int j, int i) const;
+	/** The level lies above the clip by more than the noise and 2% somewhere
+	 * in the band: its edges' transitions clip too (their top 2% and more),
+	 * whose samples lie below the fill's level, imputeClippedSide()'s case.
+	 * Less cuts too little of a transition to move an edge. */
+	bool aboveClip() const;
+};
+
+/** The fill level of a band (profile indices i0..i1 of each \a n-sample
+ * profile of \a g_profiles, \a fill their tally) where only part of it
+ * clips. Flat where the clipped fraction is even over the band (or the
+ * level's slopes stay under the noise): then from \a fill's median and
+ * clipped fraction (a censored normal, robust to the band's few samples of
+ * neighbouring blur); else by censored (Tobit) regression. Nullopt with
+ * under 10 samples on either side of the clip, or without convergence. */
+std::optional<FillLevel> fitFillLevel(
+	const std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill);
+
+/** Every sample at 255 of \a g_profiles gets the expectation of a sample of
+ * \a level above the clip at its place (only the fill's noise clips). */
+void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level);
 
 /** The noise of G [grey levels] in the always-black centre code cell of the
  * quadrangle \a coarse (around its diagonals' intersection, the projected

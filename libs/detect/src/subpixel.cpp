@@ -295,7 +295,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		bool side_saturated = saturated > half_count;
 		const bool side_clipped = clipped > half_count;
 		// Where G clips, restore the clipped samples before the edges are
-		// read (imputeClippedFill(), imputeClippedSide()): the clip cuts the
+		// read (imputeFillLevel(), imputeClippedSide()): the clip cuts the
 		// bright half of the response. The fill band from the coarse line
 		// (within about a pixel of the edge): beyond the edge's blur, short
 		// of the code board.
@@ -306,15 +306,16 @@ std::optional<RefinedQuad> refineQuadrangle(
 						   band.fraction() > p.clipped_fraction;
 		bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
 		// Part of the fill unclipped: only its noise clips, unless its level
-		// is above the clip somewhere.
-		bool above_clip = false;  // part unclipped, but the level above the clip
-		if (clips && !all_clipped)
+		// is above the clip somewhere (the transitions clip too: the edge
+		// model's case, below).
+		std::optional<FillLevel> level;
+		if (clips && !all_clipped) level = fitFillLevel(g_prof, n, band0, band1, band);
+		const bool above_clip = level && level->aboveClip();
+		all_clipped = all_clipped || above_clip;
+		if (level && !above_clip)
 		{
-			// A level above the clip is the edge model's case too (the
-			// transitions clip).
-			if (imputeClippedFill(g_prof, n, band0, band1, band, &all_clipped))
-				side_saturated = false;
-			above_clip = all_clipped;
+			imputeFillLevel(g_prof, n, *level);
+			side_saturated = false;
 		}
 		std::vector<std::optional<double>> edges(pos.size());
 		const auto locateAll = [&](bool saturated_path)
@@ -380,8 +381,11 @@ std::optional<RefinedQuad> refineQuadrangle(
 				locateAll(false);
 			// Refused (a JPEG's chroma, a sharp edge) where part of the fill
 			// is unclipped: the fill's own model still restores its noise.
-			else if (above_clip && imputeClippedFill(g_prof, n, band0, band1, band))
+			else if (above_clip)
+			{
+				imputeFillLevel(g_prof, n, *level);
 				locateAll(false);
+			}
 		}
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
