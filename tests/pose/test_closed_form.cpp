@@ -367,6 +367,22 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
 	cfg.write("POSE", "sigma_px", -1.0);
 	EXPECT_THROW(r.loadFromConfigFile(cfg, "POSE"), std::invalid_argument);
+	// Not numbers at all (MRPT would read 0.03 and 0): named, not taken.
+	for (const char* key : {"clipped_side_sigma_px", "lm_max_iterations"})
+	{
+		mrpt::config::CConfigFileMemory bad;
+		o.saveToConfigFile(bad, "POSE");
+		bad.write("POSE", key, std::string("0.03px"));
+		try
+		{
+			r.loadFromConfigFile(bad, "POSE");
+			ADD_FAILURE() << key << " = 0.03px was accepted";
+		}
+		catch (const std::exception& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+		}
+	}
 	EXPECT_EQ(sigmaSourceFromString("detector"), SigmaSource::Detector);
 	EXPECT_THROW(sigmaSourceFromString("auto"), std::invalid_argument);
 }
@@ -392,6 +408,12 @@ TEST(Options, SigmaFromTheDetector)
 	EXPECT_NEAR(measure(d, cam, g, o).C_P(1, 1), o.min_sigma_px * o.min_sigma_px, 1e-18);
 	d.quality.corner_sigma_px = 0;
 	EXPECT_NEAR(measure(d, cam, g, o).C_P(1, 1), 0.05 * 0.05, 1e-18);
+	// The detector's sigma replaces a tabulated model too.
+	d.quality.corner_sigma_px = 0.2;
+	o.sigma_x_table = sigmaTableFromString("10:0.5 100:0.4");
+	o.sigma_y_table = sigmaTableFromString("10:0.5");
+	EXPECT_NEAR(measure(d, cam, g, o).C_P(0, 0), 0.02, 1e-15);
+	EXPECT_NEAR(measure(d, cam, g, o).C_P(3, 3), 0.02, 1e-15);
 }
 
 // The size-dependent, correlated C_P of PoseOptions::primaryCovariance().

@@ -1,4 +1,5 @@
 #include <codemark/landmark/primary.h>
+#include <codemark/landmark/text.h>
 #include <codemark/pose/closed_form.h>
 #include <codemark/pose/general.h>
 #include <codemark/pose/measurement.h>
@@ -65,26 +66,16 @@ SigmaTable sigmaTableFromString(const std::string& text)
 	while (in >> entry)
 	{
 		const auto colon = entry.find(':');
-		double size = 0, sigma = 0;
-		size_t used_a = 0, used_b = 0;
-		try
-		{
-			if (colon == std::string::npos) throw std::invalid_argument("no colon");
-			size = std::stod(entry.substr(0, colon), &used_a);
-			sigma = std::stod(entry.substr(colon + 1), &used_b);
-		}
-		catch (const std::exception&)
-		{
-			used_a = 0;
-		}
-		if (colon == std::string::npos || used_a != colon || used_b != entry.size() - colon - 1 ||
-			!(size > 0) || !(sigma > 0) || !std::isfinite(size) || !std::isfinite(sigma))
+		const auto size =
+			colon == std::string::npos ? std::nullopt : parseFiniteNumber(entry.substr(0, colon));
+		const auto sigma = size ? parseFiniteNumber(entry.substr(colon + 1)) : std::nullopt;
+		if (!size || !sigma || !(*size > 0) || !(*sigma > 0))
 			throw std::invalid_argument(
 				"sigma table: bad entry '" + entry + "' (expected size:sigma, both > 0 [px])");
-		if (!t.empty() && !(size > t.back().first))
+		if (!t.empty() && !(*size > t.back().first))
 			throw std::invalid_argument(
 				"sigma table: sizes must increase, '" + entry + "' does not");
-		t.emplace_back(size, sigma);
+		t.emplace_back(*size, *sigma);
 	}
 	return t;
 }
@@ -143,6 +134,14 @@ void PoseOptions::validate() const
 
 void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
+	// MRPT's readers take "0.05px" as 0.05 and "abc" as 0: check the numbers first.
+	requireIniNumbers(
+		c, s,
+		{"sigma_px", "sigma_y_px", "growth_x_px", "growth_y_px", "size_exponent_x",
+		 "size_exponent_y", "size_reference_px", "corr_x12", "corr_y12", "corr_growth_x12",
+		 "corr_growth_y12", "clipped_side_sigma_px", "clipped_side_correlation",
+		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio", "min_sigma_px"});
+	requireIniNumbers(c, s, {"lm_max_iterations"}, true);
 	method = poseMethodFromString(c.read_string(s, "method", toString(method)));
 	MRPT_LOAD_CONFIG_VAR(sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(sigma_y_px, double, c, s);
@@ -287,10 +286,8 @@ Eigen::Matrix4d PoseOptions::alignedEdgesCovariance(
 {
 	Eigen::Matrix4d C = Eigen::Matrix4d::Zero();
 	if (aligned_edge_ratio <= 0) return C;
-	// sigma_y(h) of the y model (without its correlation).
-	PoseOptions plain = *this;
-	plain.corr_y12 = plain.corr_growth_y12 = 0;
-	const double vy = plain.primaryCovariance(P)(1, 1);
+	// sigma_y(h)^2 of the y model (the diagonal holds no correlation).
+	const double vy = primaryCovariance(P)(1, 1);
 	const auto weight = [](double rows) { return std::max(0.0, 1 - std::abs(rows)); };
 	// Each aligned edge's shift d moves y1 and y2 by d / 2.
 	const double h = 0.25 * aligned_edge_ratio * aligned_edge_ratio * vy *
@@ -378,6 +375,9 @@ Measurement measure(
 		o.sigma_y_px = 0;
 		o.growth_x_px = o.growth_y_px = 0;
 		o.corr_x12 = o.corr_y12 = 0;
+		// The tables would override the detector's sigma.
+		o.sigma_x_table.clear();
+		o.sigma_y_table.clear();
 	}
 	return measureWith(detection.corners, camera, geometry, o, detection.quality.fill_clipped);
 }

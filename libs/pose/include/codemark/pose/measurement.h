@@ -41,7 +41,8 @@ enum class SigmaSource
 	/** The detector's own per-detection estimate
 	 * (DetectionQuality::corner_sigma_px, per corner coordinate; each
 	 * component of P then has corner_sigma_px / sqrt(2)), floored at
-	 * PoseOptions::min_sigma_px; sigma_px where the detector gives none. */
+	 * PoseOptions::min_sigma_px, in place of sigma_px, the growth terms and
+	 * the sigma tables; sigma_px where the detector gives none. */
 	Detector
 };
 
