@@ -113,6 +113,14 @@ int main(int argc, char** argv)
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
+		if (n_arg.getValue() < 1 || !(dmin_arg.getValue() > 0) ||
+			!(dmax_arg.getValue() > dmin_arg.getValue()) || !(amax_arg.getValue() >= 0) ||
+			!(amax_arg.getValue() < 90) || !(bearing_arg.getValue() >= 0) ||
+			!(height_arg.getValue() >= 0) || !(level_arg.getValue() >= 0) ||
+			!(level_arg.getValue() <= 1))
+			throw std::invalid_argument(
+				"expected --renders >= 1, 0 < --min-distance < --max-distance, --max-angle in "
+				"[0, 90), --max-bearing and --max-height >= 0, --level-fraction in [0, 1]");
 
 		sim::Scene scene;
 		MapLandmark lm;
@@ -202,6 +210,12 @@ int main(int argc, char** argv)
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
+		// A fit of a handful would print numbers that mean nothing.
+		if (samples.size() < 20)
+			throw std::runtime_error(
+				std::to_string(samples.size()) +
+				" detections: at least 20 are needed for a fit (more --renders, or distances the "
+				"landmark is detected at)");
 
 		// Maximum-likelihood fit (grid search) of the noise model of
 		// PoseOptions::primaryCovariance and clippedSidesCovariance: each
