@@ -106,6 +106,12 @@ int main(int argc, char** argv)
 			"the survey grid, which makes far views the majority and leaves the near-range floor "
 			"of the noise model to few samples).",
 			cmd, false);
+		TCLAP::SwitchArg averaged_arg(
+			"", "averaged",
+			"Fit the power-law model with clipped and unclipped sides averaged "
+			"(clipped_side_sigma_px 0), the form of the shipped "
+			"pipeline::detectorCalibratedPoseOptions().",
+			cmd, false);
 		TCLAP::ValueArg<std::string> detector_arg(
 			"", "detector-config", "Detector options ini (share/codemark/detector.ini's format).",
 			false, "", "FILE", cmd);
@@ -277,7 +283,7 @@ int main(int argc, char** argv)
 		for (const auto& s : samples)
 			for (const bool c : s.clipped) n_clipped += c;
 		Fit fx, fy;
-		for (int m = 0; m <= (n_clipped > 20 ? 16 : 0); ++m)
+		for (int m = 0; m <= (n_clipped > 20 && !averaged_arg.getValue() ? 16 : 0); ++m)
 		{
 			const double clip = 0.005 * m;
 			const Fit a = fit(true, clip), b = fit(false, clip);

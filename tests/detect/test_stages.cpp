@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 using namespace codemark;
@@ -375,6 +377,99 @@ TEST(Subpixel, PeakModeLocatesAGaussianBlurredStep)
 		ASSERT_TRUE(e);
 		EXPECT_NEAR(*e, x0, 0.05);
 	}
+}
+
+// The three samples around the derivative's peak fix a pixel-integrated
+// Gaussian step exactly (stepPeak): on a sharp edge, where a Gaussian
+// through them (the log-parabola) errs with the edge's phase in its pixel,
+// and on blurred ones alike, down to the profile's 8-bit rounding.
+TEST(Subpixel, PeakModeStepModelLocatesSharpAndBlurredSteps)
+{
+	SubpixelParams model, gauss;
+	gauss.step_model_peak = false;
+	for (double sigma : {0.0, 0.3, 0.5, 0.8, 1.2})
+	{
+		double worst_model = 0, worst_gauss = 0;
+		for (double x0 = 9.0; x0 < 10.0; x0 += 0.05)
+		{
+			const auto v = stepProfile(x0, sigma, 21);
+			const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, model, EdgeMode::Peak);
+			const auto g = locateRisingEdge(v.data(), 21, 7, 13, 5, gauss, EdgeMode::Peak);
+			ASSERT_TRUE(e && g);
+			worst_model = std::max(worst_model, std::abs(*e - x0));
+			worst_gauss = std::max(worst_gauss, std::abs(*g - x0));
+		}
+		std::printf(
+			"sigma %.1f: worst %.4f px (Gaussian through the samples %.4f)\n", sigma, worst_model,
+			worst_gauss);
+		// At wide blur the three samples differ little and the profile's
+		// rounding limits both (about 0.01 px at sigma 1.2).
+		EXPECT_LE(worst_model, 0.012) << "sigma " << sigma;
+		if (sigma <= 0.5) EXPECT_GT(worst_gauss, 3 * worst_model) << "sigma " << sigma;
+	}
+}
+
+namespace
+{
+/** Profiles across a sharp inner edge as the renderer makes them: frame G
+ * 25 and B + R 50, fill G = \a level clipped at 255 and B + R 0 (B and R
+ * rounded alike), the edge at \a e0 + \a slope j in profile j of \a m. */
+void sharpEdgeProfiles(
+	double level, double e0, double slope, int m, int n, std::vector<int>& g, std::vector<int>& rb)
+{
+	g.assign(size_t(m) * n, 0);
+	rb.assign(size_t(m) * n, 0);
+	for (int j = 0; j < m; ++j)
+		for (int i = 0; i < n; ++i)
+		{
+			const double f = std::clamp(i + 0.5 - (e0 + slope * j), 0.0, 1.0);
+			g[size_t(j) * n + i] =
+				static_cast<int>(std::min(255L, std::lround(25 + (level - 25) * f)));
+			rb[size_t(j) * n + i] = -2 * static_cast<int>(std::lround(25 * (1 - f)));
+		}
+}
+}  // namespace
+
+// A band at 255 throughout is at the sensor's top or above it; B + R of the
+// transition pixels tell which, where the edge crosses pixel phases.
+TEST(Subpixel, FillLevelFromChannelsTellsATopFillFromAClippedOne)
+{
+	constexpr int m = 60, n = 21;
+	std::vector<int> g, rb;
+	for (const double e0 : {9.2, 9.6})
+	{
+		sharpEdgeProfiles(255, e0, 0.013, m, n, g, rb);
+		const auto top = fillLevelFromChannels(g, rb, n, 7, 13, 13, 18);
+		ASSERT_TRUE(top);
+		EXPECT_NEAR(top->level, 255, 1.5);
+		EXPECT_TRUE(top->atTop()) << top->level << " +- " << top->se;
+		for (const double level : {275.0, 300.0, 400.0})
+		{
+			sharpEdgeProfiles(level, e0, 0.013, m, n, g, rb);
+			const auto above = fillLevelFromChannels(g, rb, n, 7, 13, 13, 18);
+			ASSERT_TRUE(above);
+			EXPECT_FALSE(above->consistentWithTop()) << level;
+			EXPECT_FALSE(above->atTop()) << level;
+		}
+	}
+	// One phase all along (a side on the pixel grid): inconclusive, its
+	// rounding shared by every pixel.
+	sharpEdgeProfiles(255, 9.3, 0, m, n, g, rb);
+	const auto aligned = fillLevelFromChannels(g, rb, n, 7, 13, 13, 18);
+	ASSERT_TRUE(aligned);
+	EXPECT_FALSE(aligned->atTop()) << aligned->level << " +- " << aligned->se;
+	EXPECT_TRUE(aligned->consistentWithTop());
+	// On a pixel boundary: no mixed pixels, the level unknown.
+	sharpEdgeProfiles(255, 9.5, 0, m, n, g, rb);
+	const auto boundary = fillLevelFromChannels(g, rb, n, 7, 13, 13, 18);
+	ASSERT_TRUE(boundary);
+	EXPECT_FALSE(std::isfinite(boundary->se));
+	EXPECT_TRUE(boundary->consistentWithTop());
+	EXPECT_FALSE(boundary->atTop());
+	// Without B + R contrast: nothing.
+	sharpEdgeProfiles(255, 9.2, 0.013, m, n, g, rb);
+	for (int& v : rb) v /= 10;
+	EXPECT_FALSE(fillLevelFromChannels(g, rb, n, 7, 13, 13, 18));
 }
 
 namespace

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -135,12 +136,21 @@ TEST(PoseNees, GeneralPathIsConsistentOnRenders) { checkNees(1); }
 TEST(PoseNees, ClosedFormIsConsistentOnRenders) { checkNees(0); }
 
 // Noise-free renders (no noise, no blur), codemark's detector, both paths,
-// within 2 m: range to 1e-3 relative and bearing to 1e-3 rad. phi2 and the
-// pose (which carries l2 times the phi2 error) rest on y2 - y1 and miss 1e-3
-// rad at frontal views beyond about 1 m even with the detector's noise-free
-// corners (2e-3 rad at 1.5 m, 3e-3 at 2 m for the closed form), so they are
-// checked against 3 of their reported sigmas; the exact-corner round trip
-// to 1e-6 is tests/pose/test_sim.cpp.
+// within 2 m: L and the pose to 1e-3 (range and position relative to the
+// range, angles in rad), as far as the image's 8 bits allow. Noise-free is
+// not error-free: each mixed pixel of an edge is rounded, by up to half a
+// grey level of the step's contrast, and an edge along the pixel grid keeps
+// one rounding along its length. phi2 (and the position, which carries l2
+// times its error) rests on y2 - y1: at 2 m seen squarely one rounding of
+// G's 230 levels costs about 1e-3 rad, one of R + B's 25 (the estimator of
+// a side whose fill clips) about 1e-2. So phi2 and the pose are held to
+// max(1e-3, 3 sigma_q), sigma_q the pose's sigma under that rounding alone
+// (1 / sqrt(12) grey levels over the contrast of the channel each side
+// used), and must meet 1e-3 itself in most poses. Two exposures: the spec's
+// green at gain 1, whose G is exactly the sensor's top (noise-free, it
+// reads 255 with nothing clipped; the detector must tell that from a fill
+// above the clip), and gain 0.9. The exact-corner round trip to 1e-6 is
+// tests/pose/test_sim.cpp.
 TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 {
 	sim::Scene scene;
@@ -149,41 +159,70 @@ TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 	lm.z_m = 0.5;
 	scene.map.landmarks.push_back(lm);
 	scene.camera = CameraModel::paperDefault();
-	const sim::RenderOptions ro;  // all effects off
 	const LandmarkGeometry g = lm.geometry();
-	int n = 0;
-	for (const double d : {0.7, 1.0, 1.5, 2.0})
-		for (const double deg : {0.0, 20.0, -40.0, 60.0})
-		{
-			scene.world_T_camera = sim::levelCameraLookingAt(lm, d, deg * M_PI / 180, 0.05, 0.05);
-			const sim::Render img = sim::render(scene, ro, 1);
-			const SightingTruth t = sightingTruth(img.truth[0].landmark_T_camera);
-			const auto det = detect::detect(img.image, scene.camera, g, detect::DetectorOptions());
-			EXPECT_EQ(det.landmarks.size(), 1u) << d << " m " << deg << " deg";
-			if (det.landmarks.size() != 1u) continue;
-			++n;
-			for (const auto method : {pose::PoseMethod::ClosedForm, pose::PoseMethod::General6Dof})
+	int n = 0, checks = 0, within = 0;
+	for (const double gain : {1.0, 0.9})
+	{
+		sim::RenderOptions ro;	// all effects off
+		ro.gain = gain;
+		// Rounding alone: G from the frame's black to the fill, R + B (R and
+		// B rounded alike) where a side's fill clipped.
+		const double q_g = 1 / std::sqrt(12.0) / (gain * (ro.green_bgr[1] - ro.black_bgr[1]));
+		const double q_rb = 1 / std::sqrt(12.0) / (gain * ro.black_bgr[2]);
+		for (const double d : {0.7, 1.0, 1.5, 2.0})
+			for (const double deg : {0.0, 20.0, -40.0, 60.0})
 			{
-				pose::PoseOptions o = pipeline::detectorCalibratedPoseOptions();
-				o.method = method;
-				const pose::Measurement m =
-					pose::measure(det.landmarks[0].detection, scene.camera, g, o);
-				const std::string what = pose::toString(method) + " at " + std::to_string(d) +
-										 " m, " + std::to_string(deg) + " deg";
-				EXPECT_NEAR(m.L[0], t.L[0], 1e-3 * t.L[0]) << what;
-				EXPECT_NEAR(wrapToPi(m.L[1] - t.L[1]), 0, 1e-3) << what;
-				EXPECT_NEAR(wrapToPi(m.L[2] - t.L[2]), 0, 3 * std::sqrt(m.C_L(2, 2))) << what;
-				EXPECT_NEAR(
-					m.pose_in_landmark[0], t.pose_in_landmark[0], 3 * std::sqrt(m.C_R(0, 0)))
-					<< what;
-				EXPECT_NEAR(
-					m.pose_in_landmark[1], t.pose_in_landmark[1], 3 * std::sqrt(m.C_R(1, 1)))
-					<< what;
-				EXPECT_NEAR(
-					wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]), 0,
-					3 * std::sqrt(m.C_R(2, 2)))
-					<< what;
+				scene.world_T_camera =
+					sim::levelCameraLookingAt(lm, d, deg * M_PI / 180, 0.05, 0.05);
+				const sim::Render img = sim::render(scene, ro, 1);
+				const SightingTruth t = sightingTruth(img.truth[0].landmark_T_camera);
+				const auto det =
+					detect::detect(img.image, scene.camera, g, detect::DetectorOptions());
+				EXPECT_EQ(det.landmarks.size(), 1u) << d << " m " << deg << " deg";
+				if (det.landmarks.size() != 1u) continue;
+				++n;
+				for (const auto method :
+					 {pose::PoseMethod::ClosedForm, pose::PoseMethod::General6Dof})
+				{
+					// Each component of P rounded independently (the edges'
+					// phases differ; a near-aligned edge's rounding tilts it),
+					// at the coarsest channel a side used.
+					const auto& clipped = det.landmarks[0].detection.quality.fill_clipped;
+					pose::PoseOptions o;
+					o.method = method;
+					o.sigma_px =
+						std::any_of(clipped.begin(), clipped.end(), [](bool c) { return c; }) ? q_rb
+																							  : q_g;
+					const pose::Measurement m =
+						pose::measure(det.landmarks[0].detection, scene.camera, g, o);
+					const std::string what = pose::toString(method) + " at gain " +
+											 std::to_string(gain) + ", " + std::to_string(d) +
+											 " m, " + std::to_string(deg) + " deg";
+					EXPECT_NEAR(m.L[0], t.L[0], 1e-3 * t.L[0]) << what;
+					EXPECT_NEAR(wrapToPi(m.L[1] - t.L[1]), 0, 1e-3) << what;
+					const double e_phi2 = std::abs(wrapToPi(m.L[2] - t.L[2]));
+					const double e_pos = std::hypot(
+						m.pose_in_landmark[0] - t.pose_in_landmark[0],
+						m.pose_in_landmark[1] - t.pose_in_landmark[1]);
+					const double e_theta =
+						std::abs(wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]));
+					const double s_pos = std::sqrt(m.C_R(0, 0) + m.C_R(1, 1));
+					EXPECT_LE(e_phi2, std::max(1e-3, 3 * std::sqrt(m.C_L(2, 2)))) << what;
+					EXPECT_LE(e_pos, std::max(1e-3 * t.L[0], 3 * s_pos)) << what;
+					EXPECT_LE(e_theta, std::max(1e-3, 3 * std::sqrt(m.C_R(2, 2)))) << what;
+					++checks;
+					if (e_phi2 <= 1e-3 && e_pos <= 1e-3 * t.L[0] && e_theta <= 1e-3)
+						++within;
+					else
+						std::printf(
+							"noise-free, beyond 1e-3: %s: phi2 %.1e rad, position %.1e of the "
+							"range (rounding's sigma: %.1e, %.1e)\n",
+							what.c_str(), e_phi2, e_pos / t.L[0], std::sqrt(m.C_L(2, 2)),
+							s_pos / t.L[0]);
+				}
 			}
-		}
-	EXPECT_EQ(n, 16);
+	}
+	EXPECT_EQ(n, 32);
+	std::printf("noise-free: L and pose within 1e-3 in %d of %d measurements\n", within, checks);
+	EXPECT_GE(within, checks * 9 / 10);
 }

@@ -9,6 +9,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
 
 namespace codemark::detect
 {
@@ -69,21 +72,6 @@ constexpr size_t kMaxProfiles = 20;
 
 double Phi(double u) { return 0.5 * std::erfc(-u / kSqrt2); }
 double phi(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
-
-/** A Gaussian-blurred unit step (blur \a sigma) averaged over the pixel
- * [x - 1/2, x + 1/2] that samples it, and its derivatives with respect to x
- * and sigma (the integral of Phi is z Phi(z) + phi(z)). An erf of a wider
- * sigma instead misfits the steep part by about 1% of the step. */
-struct PixelStep
-{
-	double value, d_x, d_sigma;
-};
-PixelStep pixelStep(double x, double sigma)
-{
-	const double zp = (x + 0.5) / sigma, zm = (x - 0.5) / sigma;
-	const double Pp = Phi(zp), Pm = Phi(zm), fp = phi(zp), fm = phi(zm);
-	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
-}
 
 /** -log Phi(z) and its first two derivatives with respect to z (through
  * the inverse Mills ratio), stable far in the lower tail. */
@@ -240,6 +228,14 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 	return true;
 }
 }  // namespace
+
+PixelStep pixelStep(double x, double sigma)
+{
+	// The integral of Phi is z Phi(z) + phi(z).
+	const double zp = (x + 0.5) / sigma, zm = (x - 0.5) / sigma;
+	const double Pp = Phi(zp), Pm = Phi(zm), fp = phi(zp), fm = phi(zm);
+	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+}
 
 ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1)
 {
@@ -428,7 +424,93 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
 		}
 }
 
-double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
+bool ChannelFillLevel::consistentWithTop() const
+{
+	return !std::isfinite(se) || std::abs(level - 254.5) <= std::max(2 * se, 0.005 * 254.5);
+}
+
+bool ChannelFillLevel::atTop() const { return se <= 0.01 * 254.5 && consistentWithTop(); }
+
+std::optional<ChannelFillLevel> fillLevelFromChannels(
+	const std::vector<int>& g_profiles, const std::vector<int>& rb_profiles, int n, int lo, int hi,
+	int i0, int i1)
+{
+	const int m = static_cast<int>(g_profiles.size()) / n;
+	lo = std::max(lo, 3);
+	hi = std::min(hi, n - 4);
+	i0 = std::max(0, i0);
+	i1 = std::min(n - 1, i1);
+	if (m < 2 || lo > hi || i1 < i0 || rb_profiles.size() != g_profiles.size()) return std::nullopt;
+	// Each profile's steepest G rise; the frame's levels two samples
+	// outwards of it, the fill's B + R over the band (medians: robust to a
+	// neighbouring edge's blur).
+	std::vector<int> peak(m);
+	std::vector<double> g_frame, rb_frame, rb_fill;
+	for (int j = 0; j < m; ++j)
+	{
+		const int* g = g_profiles.data() + size_t(j) * n;
+		const int* rb = rb_profiles.data() + size_t(j) * n;
+		int k = lo;
+		for (int i = lo + 1; i <= hi; ++i)
+			if (g[i + 1] - g[i - 1] > g[k + 1] - g[k - 1]) k = i;
+		peak[j] = k;
+		g_frame.push_back(g[k - 2]);
+		rb_frame.push_back(-rb[k - 2]);
+		for (int i = i0; i <= i1; ++i) rb_fill.push_back(-rb[i]);
+	}
+	const auto median = [](std::vector<double>& v)
+	{
+		std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+		return v[v.size() / 2];
+	};
+	const double G0 = median(g_frame), RB0 = median(rb_frame), RB1 = median(rb_fill);
+	constexpr double kMinStep = 12;
+	const double step = RB0 - RB1;
+	if (step < kMinStep) return std::nullopt;
+	std::vector<std::pair<double, double>> pts;	 // (f, G - G_frame)
+	std::map<int, double> f_of_level;  // sum of f per B + R level
+	for (int j = 0; j < m; ++j)
+	{
+		const int* g = g_profiles.data() + size_t(j) * n;
+		const int* rb = rb_profiles.data() + size_t(j) * n;
+		for (int i = peak[j] - 1; i <= peak[j] + 2; ++i)
+		{
+			const double f = (RB0 + rb[i]) / step;
+			if (f < 0.05 || f > 0.95 || g[i] > 250) continue;
+			pts.emplace_back(f, g[i] - G0);
+			f_of_level[-rb[i]] += f;
+		}
+	}
+	// An edge within a few hundredths of a pixel boundary all along has no
+	// mixed pixels: it says nothing of the level.
+	if (pts.size() < 10)
+		return ChannelFillLevel{
+			std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()};
+	// Least squares through the origin. Noise-free, the transition pixels
+	// of a side aligned with the pixel grid share one f, whose rounding
+	// (B and R rounded alike: up to 1 level of their sum) no residual
+	// shows: pixels of one B + R level share their rounding error, which is
+	// independent between levels.
+	double sff = 0, sfg = 0, coherent = 0;
+	for (const auto& [f, dg] : pts)
+	{
+		sff += f * f;
+		sfg += f * dg;
+	}
+	for (const auto& [rb_level, f_sum] : f_of_level) coherent += f_sum * f_sum;
+	const double slope = sfg / sff;
+	double ss = 0;
+	for (const auto& [f, dg] : pts) ss += (dg - slope * f) * (dg - slope * f);
+	const double se_noise = std::sqrt(ss / double(pts.size() - 1) / sff);
+	const double se_rounding =
+		std::abs(slope) * (1 / std::sqrt(3.0)) / step * std::sqrt(coherent) / sff;
+	ChannelFillLevel out;
+	out.level = G0 + slope;
+	out.se = std::hypot(se_noise, se_rounding);
+	return out;
+}
+
+std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 {
 	// The diagonals' intersection.
 	const Eigen::Vector3d d1 =
@@ -436,16 +518,17 @@ double centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
 	const Eigen::Vector3d d2 =
 		Eigen::Vector3d(q[1].x(), q[1].y(), 1).cross(Eigen::Vector3d(q[3].x(), q[3].y(), 1));
 	const Eigen::Vector3d c = d1.cross(d2);
-	if (std::abs(c.z()) < 1e-12) return 0;
+	if (std::abs(c.z()) < 1e-12) return std::nullopt;
 	const double cx = c.x() / c.z(), cy = c.y() / c.z();
 	const double side = 0.25 * ((q[1] - q[0]).norm() + (q[2] - q[1]).norm() + (q[3] - q[2]).norm() +
 								(q[0] - q[3]).norm());
 	// Half the cell, less the reach of a blur and of JPEG ringing.
 	const int h = static_cast<int>(std::floor(0.5 * cell_rel * side - 2.5));
-	if (h < 1) return 0;
+	if (h < 1) return std::nullopt;
 	const int x0 = static_cast<int>(std::lround(cx)) - h,
 			  y0 = static_cast<int>(std::lround(cy)) - h;
-	if (x0 < 0 || y0 < 0 || x0 + 2 * h + 1 >= bgr.cols || y0 + 2 * h >= bgr.rows) return 0;
+	if (x0 < 0 || y0 < 0 || x0 + 2 * h + 1 >= bgr.cols || y0 + 2 * h >= bgr.rows)
+		return std::nullopt;
 	std::vector<double> diffs;
 	for (int y = y0; y <= y0 + 2 * h; ++y)
 	{

@@ -142,6 +142,17 @@ enum class EdgeMode
 	Peak  //!< the derivative's peak: a Gaussian through three samples
 };
 
+/** A Gaussian-blurred unit step (blur \a sigma [px]) at 0, averaged over
+ * the pixel [x - 1/2, x + 1/2] that samples it, and its derivatives with
+ * respect to x and sigma: the profile a camera's pixels take of an edge
+ * under a Gaussian point-spread function (an erf of a wider sigma misfits
+ * the steep part by about 1% of the step). */
+struct PixelStep
+{
+	double value, d_x, d_sigma;
+};
+PixelStep pixelStep(double x, double sigma);
+
 /** Sub-pixel position of a step edge on a 1D profile, from the derivative
  * (values[k+1] - values[k-1]) around its largest value within [lo, hi]
  * (indices), the edge rising in the direction of increasing index. Nullopt
@@ -236,6 +247,33 @@ struct FillLevel
 std::optional<FillLevel> fitFillLevel(
 	const std::vector<int>& g_profiles, int n, int i0, int i1, const ClippedFill& fill);
 
+/** G's fill level on a side whose fill band clips throughout, read from
+ * the unclipped channels instead: across the inner edge, B + R falls from
+ * the frame's level to the fill's in proportion to the share f of the
+ * fill in each pixel, so each unclipped transition pixel gives G's step
+ * through G - G_frame = (level - G_frame) f (least squares through the
+ * origin over pixels with f in [0.05, 0.95] and G at most 250, clear of
+ * the clip; the standard error counts the rounding of B + R, shared by
+ * pixels of one level). \a g_profiles and \a rb_profiles (-(B + R)) hold n samples a
+ * profile, the edge searched within lo..hi, the fill band i0..i1. Nullopt
+ * where B + R has under 12 levels of contrast; with under 10 such pixels
+ * (a sharp edge on a pixel boundary has none) the level is unknown: NaN,
+ * with an infinite standard error. */
+struct ChannelFillLevel
+{
+	double level = 0;  //!< G's fill level [grey levels], may exceed 255
+	double se = 0;	//!< its standard error [grey levels]
+	/** At the clip within two standard errors or 0.5% of it (a level 0.5%
+	 * above the clip moves a sharp edge's G centroid by under 0.006 px), or
+	 * unknown. */
+	bool consistentWithTop() const;
+	/** The same, conclusively: the standard error under 1% of the clip. */
+	bool atTop() const;
+};
+std::optional<ChannelFillLevel> fillLevelFromChannels(
+	const std::vector<int>& g_profiles, const std::vector<int>& rb_profiles, int n, int lo, int hi,
+	int i0, int i1);
+
 /** Every sample at 255 of \a g_profiles gets the expectation of a sample of
  * \a level above the clip at its place (only the fill's noise clips). */
 void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level);
@@ -243,9 +281,10 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
 /** The noise of G [grey levels] in the always-black centre code cell of the
  * quadrangle \a coarse (around its diagonals' intersection, the projected
  * centre), \a cell_rel the cell's side over the reference square's: robust
- * spread of neighbouring pixels' differences. 0 when the cell is under
+ * spread of neighbouring pixels' differences (0 under about half a grey
+ * level, where most differences are 0). Nullopt when the cell is under
  * 3 x 3 px in the image. */
-double centreCellNoise(const cv::Mat& bgr, const Quad& coarse, double cell_rel);
+std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& coarse, double cell_rel);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit

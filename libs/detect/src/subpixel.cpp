@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace codemark::detect
@@ -13,6 +14,9 @@ namespace
  * samples at 255, and needs this many samples to say. */
 constexpr double kAllClippedFraction = 0.9;
 constexpr int kMinFillSamples = 20;
+/** A sensor quieter than this [grey levels] (centreCellNoise() reads 0:
+ * most neighbouring pixels equal) can hold a fill at exactly its top. */
+constexpr double kQuietNoise = 0.5;
 /** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
@@ -37,6 +41,76 @@ double peakOffset(double a, double b, double c, double& var)
 	}
 	const double den = a - 2.0 * b + c;
 	return den < 0 ? std::clamp(0.5 * (a - c) / den, -0.5, 0.5) : 0.0;
+}
+
+/** The derivative peak of three samples \a d at peak - 1, peak, peak + 1
+ * refined with the exact response of a pixel-integrated Gaussian step:
+ * the central difference at sample k of a step of height A at e, blurred
+ * by sigma, is A (S(k + 1 - e) - S(k - 1 - e)), S = pixelStep().value. The
+ * three samples fix e, sigma and A (damped Newton from the log-parabola's
+ * \a e0 and \a var0). The log-parabola's Gaussian is that response only
+ * for a wide blur: on a sharp edge (three samples f, 1, 1 - f of the step)
+ * it errs by up to 0.07 px with the edge's phase in its pixel. Returns
+ * \a e0 where the fit fails. Written by hand: it runs once per profile,
+ * where cv::LMSolver's set-up would cost more than the fit. */
+double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0)
+{
+	// Variance of the central difference of the step: the blur's, the
+	// pixel's (1/12) and the difference's 2-px box (1/3).
+	constexpr double kSamplingVar = 1.0 / 12 + 1.0 / 3;
+	constexpr double kMinSigma = 0.01, kMaxSigma = 3;
+	Eigen::Vector3d q(
+		e0,
+		std::clamp(
+			var0 > kSamplingVar ? std::sqrt(var0 - kSamplingVar) : 0.5, kMinSigma, kMaxSigma),
+		0);
+	const auto model = [&](const Eigen::Vector3d& x, Eigen::Matrix3d* J)
+	{
+		Eigen::Vector3d r;
+		for (int i = 0; i < 3; ++i)
+		{
+			const int k = peak - 1 + i;
+			const PixelStep sp = pixelStep(k + 1 - x[0], x[1]), sm = pixelStep(k - 1 - x[0], x[1]);
+			r[i] = x[2] * (sp.value - sm.value) - d[i];
+			if (J)
+				J->row(i) << x[2] * (sm.d_x - sp.d_x), x[2] * (sp.d_sigma - sm.d_sigma),
+					sp.value - sm.value;
+		}
+		return r;
+	};
+	{
+		const PixelStep sp = pixelStep(peak + 1 - q[0], q[1]),
+						sm = pixelStep(peak - 1 - q[0], q[1]);
+		if (sp.value - sm.value <= 0) return e0;
+		q[2] = d[1] / (sp.value - sm.value);
+	}
+	Eigen::Matrix3d J;
+	Eigen::Vector3d r = model(q, &J);
+	double cost = r.squaredNorm(), mu = 1e-3;
+	const double tol = 1e-12 * d[1] * d[1];
+	for (int it = 0; it < 20 && cost > tol && mu < 1e8; ++it)
+	{
+		Eigen::Matrix3d A = J.transpose() * J;
+		A.diagonal() += mu * A.diagonal().cwiseMax(1e-12);
+		const Eigen::Vector3d step = -A.ldlt().solve(J.transpose() * r);
+		if (!step.allFinite()) break;
+		Eigen::Vector3d cand = q + step;
+		cand[0] = std::clamp(cand[0], peak - 1.0, peak + 1.0);
+		cand[1] = std::clamp(cand[1], kMinSigma, kMaxSigma);
+		Eigen::Matrix3d Jc;
+		const Eigen::Vector3d rc = model(cand, &Jc);
+		if (rc.squaredNorm() < cost)
+		{
+			q = cand;
+			r = rc;
+			J = Jc;
+			cost = rc.squaredNorm();
+			mu = std::max(1e-9, mu * 0.3);
+		}
+		else
+			mu *= 10;
+	}
+	return std::abs(q[0] - e0) <= 0.5 ? q[0] : e0;
 }
 }  // namespace
 
@@ -63,6 +137,8 @@ std::optional<double> locateRisingEdge(
 		const int km = peak - 1 >= 1 ? peak - 1 : peak, kp = peak + 1 <= n - 2 ? peak + 1 : peak;
 		double var = 0;
 		double e = peak + peakOffset(d(km), dp, d(kp), var);
+		// The three samples last fitted (with the lobe removed).
+		std::array<double, 3> fitted{double(d(km)), double(dp), double(d(kp))};
 		// A falling edge neighbour_px before this one (the frame's outer
 		// edge) adds a negative lobe whose tail tilts the three samples and
 		// pulls the peak away from it, by up to half a pixel when the frame
@@ -101,10 +177,11 @@ std::optional<double> locateRisingEdge(
 					e = peak + off;
 					var = v2;
 					amp = b;
+					fitted = {a, b, c};
 				}
 			}
 		}
-		return e;
+		return km < peak && kp > peak && p.step_model_peak ? stepPeak(fitted, peak, e, var) : e;
 	}
 	// The response of a blurred step: sum the derivative while it stays
 	// positive and above a fraction of the peak; its centroid is the edge
@@ -208,8 +285,21 @@ std::optional<RefinedQuad> refineQuadrangle(
 	const Eigen::Vector2d centre = 0.25 * (coarse[0] + coarse[1] + coarse[2] + coarse[3]);
 	const int W = bgr.cols, H = bgr.rows;
 	const int half = p.search_px + p.reach_px + 2;
-	double noise = -1;	// the centre cell's, when a side clips
-	for (int side = 0; side < 4; ++side)
+	// The sensor's noise in the centre cell, read once when a side clips.
+	bool noise_read = false;
+	std::optional<double> noise;
+	const auto sensorNoise = [&]
+	{
+		if (!noise_read) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+		noise_read = true;
+		return noise;
+	};
+	// The G fill level of each side that clips throughout, from its
+	// unclipped channels (fillLevelFromChannels()); undecided: consistent
+	// with the top but inconclusive.
+	std::array<std::optional<ChannelFillLevel>, 4> channel_level;
+	std::array<bool, 4> undecided{};
+	const auto refineSide = [&](int side, bool retry) -> bool
 	{
 		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
 		// bottom: BR-BL, left: BL-TL).
@@ -302,9 +392,26 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const double fill_px = frame_px * fill_ratio / frame_ratio;
 		const int band0 = half + 3, band1 = half + static_cast<int>(std::floor(fill_px - 3));
 		const ClippedFill band = clippedFill(g_prof, n, band0, band1);
-		const bool clips = p.model_clipping && band.count() >= kMinFillSamples &&
-						   band.fraction() > p.clipped_fraction;
+		bool clips = p.model_clipping && band.count() >= kMinFillSamples &&
+					 band.fraction() > p.clipped_fraction;
 		bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
+		// A band at 255 throughout need not lie above the clip: a noise-free
+		// fill at exactly the sensor's top reads 255 everywhere with none of
+		// its transitions clipped. There G's own edge is exact, while the
+		// clip's estimators are not (R + B next to the G peak has 50 levels
+		// of contrast: 0.02 px of rounding). The unclipped channels tell.
+		// Only a quiet sensor (noise under half a grey level) does that: with
+		// more, a fill at the top leaves part of its band unclipped, and one
+		// at 255 throughout is above it, its noise clipped too.
+		bool at_top = false;
+		if (all_clipped && sensorNoise().value_or(kQuietNoise) < kQuietNoise)
+		{
+			auto& c = channel_level[side];
+			if (!retry) c = fillLevelFromChannels(g_prof, rb_prof, n, lo, hi, band0, band1);
+			at_top = c && (retry ? c->consistentWithTop() : c->atTop());
+			undecided[side] = !at_top && c && c->consistentWithTop();
+		}
+		if (at_top) clips = all_clipped = side_saturated = false;
 		// Part of the fill unclipped: only its noise clips, unless its level
 		// is above the clip somewhere (the transitions clip too: the edge
 		// model's case, below).
@@ -365,11 +472,10 @@ std::optional<RefinedQuad> refineQuadrangle(
 		locateAll(side_saturated);
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
-		out.fill_clipped[side] = all_clipped || (band.count() >= kMinFillSamples &&
+		out.fill_clipped[side] = all_clipped || (!at_top && band.count() >= kMinFillSamples &&
 												 band.fraction() >= kAllClippedFraction);
 		if (all_clipped)
 		{
-			if (noise < 0) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
 			ClippedSideProfiles clip_side;
 			clip_side.image = &bgr;
 			clip_side.rows = along == 1;
@@ -377,7 +483,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 			clip_side.inward = inward;
 			clip_side.along = pos;
 			for (const int c0 : origin) clip_side.base.push_back(c0 - inward * half);
-			if (imputeClippedSide(clip_side, edges, frame_px, fill_px, noise, g_prof))
+			if (imputeClippedSide(
+					clip_side, edges, frame_px, fill_px, sensorNoise().value_or(0), g_prof))
 				locateAll(false);
 			// Refused (a JPEG's chroma, a sharp edge) where part of the fill
 			// is unclipped: the fill's own model still restores its noise.
@@ -401,9 +508,20 @@ std::optional<RefinedQuad> refineQuadrangle(
 			pts.push_back(pt);
 		}
 		auto f = fitLine(std::move(pts), p);
-		if (!f) return std::nullopt;
+		if (!f) return false;
 		out.sides[side] = std::move(*f);
-	}
+		return true;
+	};
+	for (int side = 0; side < 4; ++side)
+		if (!refineSide(side, false)) return std::nullopt;
+	// A side along the pixel grid, noise-free, has one sample phase: its
+	// own channel level cannot tell a fill at the top from one above it.
+	// The fill is one sheet under one light: where another side is at the
+	// top, so is this one if its own estimate agrees.
+	const bool some_at_top = std::any_of(
+		channel_level.begin(), channel_level.end(), [](const auto& c) { return c && c->atTop(); });
+	for (int side = 0; side < 4; ++side)
+		if (some_at_top && undecided[side] && !refineSide(side, true)) return std::nullopt;
 	// Corner k = side k-1 x side k (TL = left x top, ...).
 	for (int k = 0; k < 4; ++k)
 	{

@@ -175,6 +175,11 @@ struct SubpixelParams
 	 * lobe's tail pulls the peak inwards by 0.2-0.5 px when the frame is
 	 * 1.6-2.3 px wide (5 m at 45-60 deg). */
 	bool model_outer_edge = true;
+	/** Refine the derivative's peak with the exact response of a
+	 * pixel-integrated Gaussian step (its position, blur and height from
+	 * the three samples) instead of the log-parabola's Gaussian, which
+	 * errs with the edge's phase in its pixel on sharp edges. */
+	bool step_model_peak = true;
 	/** Smallest slope of R + B accepted on a saturated profile [grey levels
 	 * per px]. */
 	double min_rise_rb = 4;
