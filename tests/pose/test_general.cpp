@@ -3,6 +3,7 @@
 // cameras, tilted cameras with lens distortion, ambiguity and covariance.
 #include <codemark/landmark/primary.h>
 #include <codemark/landmark/truth.h>
+#include <codemark/pose/closed_form.h>
 #include <codemark/pose/general.h>
 #include <codemark/pose/measurement.h>
 #include <gtest/gtest.h>
@@ -231,6 +232,22 @@ TEST(General, TiltedCameraWithLensDistortion)
 		EXPECT_NEAR(m.L[1], st.L[1], 1e-6);
 		EXPECT_NEAR(m.L[2], st.L[2], 1e-6);
 		EXPECT_NEAR(wrapToPi(m.pose_in_landmark[2] - st.pose_in_landmark[2]), 0, 1e-6);
+		// The planar pose is poseFromLandmark(L) on this path too, and its
+		// first-order C_R is J_L C_L J_L^T: what lets measure() take C_R to
+		// second order in C_L here as on the closed form.
+		Eigen::Matrix3d J_L;
+		const Eigen::Vector3d from_L = poseFromLandmark(m.L, &J_L);
+		EXPECT_LT((from_L.head<2>() - m.pose_in_landmark.head<2>()).norm(), 1e-9 * dd);
+		EXPECT_NEAR(wrapToPi(from_L[2] - m.pose_in_landmark[2]), 0, 1e-9);
+		const Eigen::Matrix3d first = J_L * m.C_L * J_L.transpose();
+		EXPECT_LT((first - m.C_R).norm(), 1e-5 * m.C_R.norm()) << "i " << i;
+		PoseOptions gen2 = gen;
+		gen2.second_order_pose_covariance = true;
+		const Measurement m2 = measure(corners, cam, g, gen2);
+		EXPECT_LT((m2.C_R - poseCovarianceSecondOrder(m.L, m.C_L)).norm(), 1e-12 * m.C_R.norm());
+		EXPECT_GE(
+			Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m2.C_R - m.C_R).eigenvalues().minCoeff(),
+			-1e-9 * m.C_R.norm());
 		// The closed form, which assumes a level camera, is biased here.
 		PoseOptions cf;
 		const Measurement mc = measure(corners, cam, g, cf);

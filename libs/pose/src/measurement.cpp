@@ -349,7 +349,9 @@ Measurement measureWith(
 	m.L = g.L;
 	m.C_L = g.C_L;
 	m.pose_in_landmark = g.pose_in_landmark;
-	m.C_R = g.C_R;
+	// The planar pose is poseFromLandmark(L) on this path too: the same
+	// curvature beyond 2 m (poseCovarianceSecondOrder()).
+	m.C_R = options.second_order_pose_covariance ? poseCovarianceSecondOrder(m.L, m.C_L) : g.C_R;
 	m.landmark_T_camera = g.solutions[0].landmark_T_camera;
 	m.reprojection_rms_px = g.solutions[0].rms_px;
 	m.ambiguity_ratio = g.ambiguity_ratio;

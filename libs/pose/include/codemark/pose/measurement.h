@@ -194,8 +194,9 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** With SigmaSource::Detector: the smallest sigma of a component of P
 	 * accepted from the detector [px] (a line fit can be over-confident). */
 	double min_sigma_px = 0.01;
-	/** Closed form: C_R to second order in C_L (poseCovarianceSecondOrder())
-	 * instead of the spec's first order J_L C_L J_L^T. ini key
+	/** C_R to second order in C_L (poseCovarianceSecondOrder()) instead of
+	 * the spec's first order J_L C_L J_L^T; on both paths (the general one
+	 * reduces its 6-DoF pose to the same planar pose of L). ini key
 	 * `second_order_pose_covariance`. */
 	bool second_order_pose_covariance = false;
 	/** Closed form: refine L by weighted least squares on P with C_P
