@@ -405,7 +405,10 @@ TEST(Subpixel, PeakModeStepModelLocatesSharpAndBlurredSteps)
 		// At wide blur the three samples differ little and the profile's
 		// rounding limits both (about 0.01 px at sigma 1.2).
 		EXPECT_LE(worst_model, 0.012) << "sigma " << sigma;
-		if (sigma <= 0.5) EXPECT_GT(worst_gauss, 3 * worst_model) << "sigma " << sigma;
+		if (sigma <= 0.5)
+		{
+			EXPECT_GT(worst_gauss, 3 * worst_model) << "sigma " << sigma;
+		}
 	}
 }
 

@@ -229,6 +229,21 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 }
 }  // namespace
 
+void pixelSteps(double x0, double sigma, int count, PixelStep* out)
+{
+	// Sample i covers [x0 + i - 1/2, x0 + i + 1/2]: neighbours share a
+	// boundary, so count + 1 evaluations of Phi and phi serve all.
+	double zm = (x0 - 0.5) / sigma, Pm = Phi(zm), fm = phi(zm);
+	for (int i = 0; i < count; ++i)
+	{
+		const double zp = zm + 1 / sigma, Pp = Phi(zp), fp = phi(zp);
+		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+		zm = zp;
+		Pm = Pp;
+		fm = fp;
+	}
+}
+
 PixelStep pixelStep(double x, double sigma)
 {
 	// The integral of Phi is z Phi(z) + phi(z).
@@ -411,16 +426,22 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
 	// the fill is about at the top).
 	constexpr double c = 254.5;
 	const int m = static_cast<int>(g_profiles.size()) / n;
+	const auto expected = [&](double mu)
+	{
+		const double z = (c - mu) / level.sigma, tail = Phi(-z);
+		const double e =
+			tail > 1e-12 ? mu + level.sigma * phi(z) / tail : c + level.sigma / std::max(1.0, z);
+		return static_cast<int>(std::lround(std::max(c, e)));
+	};
+	// A flat level (the common case) has one expectation for every sample.
+	const bool flat = level.beta[1] == 0 && level.beta[2] == 0;
+	const int flat_value = flat ? expected(level.beta[0]) : 0;
 	for (int j = 0; j < m; ++j)
 		for (int i = 0; i < n; ++i)
 		{
 			int& v = g_profiles[j * n + i];
 			if (v < 255) continue;
-			const double mu = level.design(j, i).dot(level.beta), z = (c - mu) / level.sigma;
-			const double tail = Phi(-z);
-			const double e = tail > 1e-12 ? mu + level.sigma * phi(z) / tail
-										  : c + level.sigma / std::max(1.0, z);
-			v = static_cast<int>(std::lround(std::max(c, e)));
+			v = flat ? flat_value : expected(level.design(j, i).dot(level.beta));
 		}
 }
 

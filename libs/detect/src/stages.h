@@ -152,6 +152,10 @@ struct PixelStep
 	double value, d_x, d_sigma;
 };
 PixelStep pixelStep(double x, double sigma);
+/** pixelStep() at x0, x0 + 1, ..., x0 + count - 1 into \a out, sharing the
+ * pixels' common boundaries (count + 1 evaluations of the normal's CDF
+ * and density instead of 2 count). */
+void pixelSteps(double x0, double sigma, int count, PixelStep* out);
 
 /** Sub-pixel position of a step edge on a 1D profile, from the derivative
  * (values[k+1] - values[k-1]) around its largest value within [lo, hi]

@@ -64,13 +64,18 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 		std::clamp(
 			var0 > kSamplingVar ? std::sqrt(var0 - kSamplingVar) : 0.5, kMinSigma, kMaxSigma),
 		0);
-	const auto model = [&](const Eigen::Vector3d& x, Eigen::Matrix3d* J)
+	// The height A (q[2]) at 0: set from the peak sample at the first call.
+	const auto model = [&](Eigen::Vector3d& x, Eigen::Matrix3d* J)
 	{
+		// The three differences use the step at five samples, peak - 2 ..
+		// peak + 2.
+		std::array<PixelStep, 5> st;
+		pixelSteps(peak - 2 - x[0], x[1], 5, st.data());
+		if (x[2] == 0 && st[3].value > st[1].value) x[2] = d[1] / (st[3].value - st[1].value);
 		Eigen::Vector3d r;
 		for (int i = 0; i < 3; ++i)
 		{
-			const int k = peak - 1 + i;
-			const PixelStep sp = pixelStep(k + 1 - x[0], x[1]), sm = pixelStep(k - 1 - x[0], x[1]);
+			const PixelStep &sp = st[i + 2], &sm = st[i];
 			r[i] = x[2] * (sp.value - sm.value) - d[i];
 			if (J)
 				J->row(i) << x[2] * (sm.d_x - sp.d_x), x[2] * (sp.d_sigma - sm.d_sigma),
@@ -78,14 +83,9 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 		}
 		return r;
 	};
-	{
-		const PixelStep sp = pixelStep(peak + 1 - q[0], q[1]),
-						sm = pixelStep(peak - 1 - q[0], q[1]);
-		if (sp.value - sm.value <= 0) return e0;
-		q[2] = d[1] / (sp.value - sm.value);
-	}
 	Eigen::Matrix3d J;
 	Eigen::Vector3d r = model(q, &J);
+	if (q[2] <= 0) return e0;
 	double cost = r.squaredNorm(), mu = 1e-3;
 	const double tol = 1e-12 * d[1] * d[1];
 	for (int it = 0; it < 20 && cost > tol && mu < 1e8; ++it)
@@ -97,6 +97,7 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 		Eigen::Vector3d cand = q + step;
 		cand[0] = std::clamp(cand[0], peak - 1.0, peak + 1.0);
 		cand[1] = std::clamp(cand[1], kMinSigma, kMaxSigma);
+		cand[2] = std::max(cand[2], 1e-9);
 		Eigen::Matrix3d Jc;
 		const Eigen::Vector3d rc = model(cand, &Jc);
 		if (rc.squaredNorm() < cost)
@@ -106,6 +107,7 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 			J = Jc;
 			cost = rc.squaredNorm();
 			mu = std::max(1e-9, mu * 0.3);
+			if (std::abs(step[0]) < 1e-4 && std::abs(step[1]) < 1e-3) break;
 		}
 		else
 			mu *= 10;
@@ -299,6 +301,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 	// with the top but inconclusive.
 	std::array<std::optional<ChannelFillLevel>, 4> channel_level;
 	std::array<bool, 4> undecided{};
+	SubpixelParams p_centring = p;
+	p_centring.step_model_peak = false;
 	const auto refineSide = [&](int side, bool retry) -> bool
 	{
 		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
@@ -448,13 +452,16 @@ std::optional<RefinedQuad> refineQuadrangle(
 					// In R + B the frame's outer edge (white to black) rises
 					// too, a frame width away: search only next to the G
 					// peak and stop the response where it stops falling.
+					// Where R + B places the edge, the G peak only centres
+					// its search: no step model.
+					const bool rb_edge = side_clipped && mode == EdgeMode::Centroid;
 					const auto g_peak = locateRisingEdge(
-						gp, n, l, h, min_rise, p, EdgeMode::Peak,
+						gp, n, l, h, min_rise, rb_edge ? p_centring : p, EdgeMode::Peak,
 						p.model_outer_edge && !side_clipped ? frame_px : 0.0);
 					if (!g_peak) return std::nullopt;
 					std::optional<double> r;
 					const int k = static_cast<int>(std::lround(*g_peak));
-					if (side_clipped && mode == EdgeMode::Centroid)
+					if (rb_edge)
 						r = locateRisingEdge(
 							rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
 					return r ? r : g_peak;
