@@ -91,6 +91,51 @@ TEST(Renders, IlluminationGainWithGradient)
 	EXPECT_EQ(n, 32);
 }
 
+// Noise-free and sharp, a fill at exactly the sensor's top (gain 1, the
+// spec's green) reads 255 throughout like one above it (gain 1.1-1.3),
+// where its transitions clip too. Seen squarely every side runs along the
+// pixel grid with one phase, so its own channels cannot tell which
+// (fillLevelFromChannels()); the detector must still place each edge to
+// about B + R's rounding (0.02 px) or better: at the top by G's own edges
+// (0.002 px) where they lie inwards of B + R's (a clipped G only errs
+// outwards), above it without taking G's clipped ones (up to 0.1 px out).
+// Without that test: gain 1 mean 0.0087 px, worst 0.021.
+TEST(Renders, NoiseFreeFillAtOrAboveTheTopSeenSquarely)
+{
+	for (const double gain : {1.0, 1.1, 1.3})
+	{
+		double worst = 0, sum = 0;
+		int n = 0;
+		for (const double dist : {1.0, 1.5, 2.0})
+			for (const double bearing : {0.0, 0.013, 0.031, 0.05})
+			{
+				sim::RenderOptions o;  // no noise, no blur
+				o.gain = gain;
+				const Shot s = shoot(37, dist, 0, o, 1, bearing, 0.05);
+				const auto& t = s.render.truth[0];
+				const auto r = detect::detect(
+					s.render.image, CameraModel(), LandmarkGeometry(), DetectorOptions());
+				ASSERT_EQ(r.landmarks.size(), 1u) << gain << " " << dist << " " << bearing;
+				for (int k = 0; k < 4; ++k)
+				{
+					const double e = (r.landmarks[0].detection.corners[k] - t.corners_px[k]).norm();
+					worst = std::max(worst, e);
+					sum += e;
+					++n;
+				}
+			}
+		std::printf(
+			"[ top ] gain %.1f noise-free, seen squarely: corner error mean %.4f px, worst %.4f "
+			"px\n",
+			gain, sum / n, worst);
+		// A corner joins two edges, each within R + B's rounding (0.02 px)
+		// where it is read there; at the top G takes over where it errs
+		// less (about half of such sides), above it R + B keeps them.
+		EXPECT_LT(worst, gain == 1.0 ? 0.03 : 0.05) << "gain " << gain;
+		EXPECT_LT(sum / n, gain == 1.0 ? 0.005 : 0.02) << "gain " << gain;
+	}
+}
+
 // A fill brighter than the sensor's top clips G on the bright half of the
 // inner edge's response: read as it is, the edge moves outwards and the
 // square looks larger (a range error). The edge model fitted with the clip

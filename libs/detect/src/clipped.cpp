@@ -506,7 +506,8 @@ std::optional<ChannelFillLevel> fillLevelFromChannels(
 	// mixed pixels: it says nothing of the level.
 	if (pts.size() < 10)
 		return ChannelFillLevel{
-			std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()};
+			std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+			step};
 	// Least squares through the origin. Noise-free, the transition pixels
 	// of a side aligned with the pixel grid share one f, whose rounding
 	// (B and R rounded alike: up to 1 level of their sum) no residual
@@ -528,6 +529,7 @@ std::optional<ChannelFillLevel> fillLevelFromChannels(
 	ChannelFillLevel out;
 	out.level = G0 + slope;
 	out.se = std::hypot(se_noise, se_rounding);
+	out.rb_step = step;
 	return out;
 }
 

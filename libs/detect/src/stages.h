@@ -267,6 +267,10 @@ struct ChannelFillLevel
 {
 	double level = 0;  //!< G's fill level [grey levels], may exceed 255
 	double se = 0;	//!< its standard error [grey levels]
+	double rb_step = 0;	 //!< B + R's fall from the frame to the fill [grey levels]
+	/** The largest error [px] that rounding gives an edge located in B + R
+	 * (B and R rounded alike: half of two levels of their sum's step). */
+	double rbRoundingPx() const { return rb_step > 0 ? 1.0 / rb_step : 0; }
 	/** At the clip within two standard errors or 0.5% of it (a level 0.5%
 	 * above the clip moves a sharp edge's G centroid by under 0.006 px), or
 	 * unknown. */

@@ -17,6 +17,8 @@ constexpr int kMinFillSamples = 20;
 /** A sensor quieter than this [grey levels] (centreCellNoise() reads 0:
  * most neighbouring pixels equal) can hold a fill at exactly its top. */
 constexpr double kQuietNoise = 0.5;
+/** G's own rounding on an edge of the spec's contrast (230 levels) [px]. */
+constexpr double kGRoundingPx = 0.5 / 230;
 /** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
@@ -300,7 +302,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 	// unclipped channels (fillLevelFromChannels()); undecided: consistent
 	// with the top but inconclusive.
 	std::array<std::optional<ChannelFillLevel>, 4> channel_level;
-	std::array<bool, 4> undecided{};
+	std::array<bool, 4> undecided{}, channels_agree{};
 	SubpixelParams p_centring = p;
 	p_centring.step_model_peak = false;
 	const auto refineSide = [&](int side, bool retry) -> bool
@@ -477,6 +479,30 @@ std::optional<RefinedQuad> refineQuadrangle(
 			}
 		};
 		locateAll(side_saturated);
+		// Undecided (a side along the pixel grid, one rounding of R + B all
+		// along): a fill above the top moves G's edges outwards only (its
+		// clip cuts the bright half of their response), by up to a tenth of
+		// a pixel. So where G's edges lie inwards of R + B's (less G's own
+		// rounding) and within R + B's rounding of them, G errs less than
+		// R + B whatever the level, and exactly nothing at the top.
+		if (undecided[side] && !retry && side_saturated && side_clipped &&
+			mode == EdgeMode::Centroid)
+		{
+			const auto rb_edges = edges;
+			locateAll(false);
+			double sum = 0;
+			int count = 0;
+			for (size_t j = 0; j < edges.size(); ++j)
+				if (edges[j] && rb_edges[j])
+				{
+					sum += *edges[j] - *rb_edges[j];
+					++count;
+				}
+			const double rounding = channel_level[side]->rbRoundingPx();
+			const double inwards = count > 0 ? sum / count : -1;
+			channels_agree[side] = count >= 10 && inwards >= -kGRoundingPx && inwards <= rounding;
+			edges = rb_edges;
+		}
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
 		out.fill_clipped[side] = all_clipped || (!at_top && band.count() >= kMinFillSamples &&
@@ -524,11 +550,13 @@ std::optional<RefinedQuad> refineQuadrangle(
 	// A side along the pixel grid, noise-free, has one sample phase: its
 	// own channel level cannot tell a fill at the top from one above it.
 	// The fill is one sheet under one light: where another side is at the
-	// top, so is this one if its own estimate agrees.
+	// top, so is this one if its own estimate agrees; so is one whose G and
+	// R + B edges agree.
 	const bool some_at_top = std::any_of(
 		channel_level.begin(), channel_level.end(), [](const auto& c) { return c && c->atTop(); });
 	for (int side = 0; side < 4; ++side)
-		if (some_at_top && undecided[side] && !refineSide(side, true)) return std::nullopt;
+		if (undecided[side] && (some_at_top || channels_agree[side]) && !refineSide(side, true))
+			return std::nullopt;
 	// Corner k = side k-1 x side k (TL = left x top, ...).
 	for (int k = 0; k < 4; ++k)
 	{
