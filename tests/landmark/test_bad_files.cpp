@@ -114,7 +114,7 @@ TEST(BadFiles, RosYamlBadNumberAndSyntaxError)
 	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
-TEST(BadFiles, YamlDirectivesAndControlCharactersAreRefused)
+TEST(BadFiles, YamlDirectivesTabsAndControlCharactersAreRefused)
 {
 	// libfyaml 0.8 loops forever on some directives (found by fuzz_camera),
 	// also after a lone '\r' line break; camera files never hold any.
@@ -124,4 +124,13 @@ TEST(BadFiles, YamlDirectivesAndControlCharactersAreRefused)
 	const auto control = writeTemp("control.yaml", std::string("image_width: 3\x01\n", 16));
 	EXPECT_NE(
 		errorOf([&] { CameraModel::load(control); }).find("control character"), std::string::npos);
+	// libfyaml 0.8 segfaults reporting this one (fuzz_camera): tabs in a
+	// malformed plain scalar.
+	const std::string tabs(40, '\t');
+	const auto tabbed = writeTemp(
+		"tabs.yaml", "image_width: 640\nimage_height: 480\ncam" + tabs + "m" + tabs + "[-0am" +
+						 tabs + ".ols: 5\n  " + tabs + "en [-0am" + tabs +
+						 ".ols: 5\n  data:0, 0, 0]\n");
+	const std::string t = errorOf([&] { CameraModel::load(tabbed); });
+	EXPECT_NE(t.find(tabbed + ":3: tab character"), std::string::npos) << t;
 }

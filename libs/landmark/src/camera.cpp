@@ -211,9 +211,11 @@ void requireYamlNumbers(
 }
 
 /** Refuses what no camera YAML holds but makes libfyaml (0.8, Debian
- * bookworm, inside MRPT's YAML reader) loop forever, found by fuzzing: a
- * '%' directive line with non-ASCII bytes. Camera files are plain ASCII
- * text without directives; say so instead of hanging. */
+ * bookworm, inside MRPT's YAML reader) loop forever or crash, found by
+ * fuzzing: a '%' directive line with non-ASCII bytes (a hang), tabs in a
+ * malformed plain scalar (a segfault in its own error report). Camera files
+ * are plain ASCII text without directives, indented with spaces; say so
+ * instead of hanging or crashing. */
 void requirePlainYamlText(const std::string& path)
 {
 	std::ifstream in(path, std::ios::binary);
@@ -233,7 +235,11 @@ void requirePlainYamlText(const std::string& path)
 			throw std::runtime_error(
 				path + ":" + std::to_string(line) +
 				": YAML directives ('%...') are not supported here");
-		if ((u < 0x20 && u != '\t') || u == 0x7f)
+		if (u == '\t')
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) +
+				": tab character (camera YAML files take spaces only)");
+		if (u < 0x20 || u == 0x7f)
 			throw std::runtime_error(
 				path + ":" + std::to_string(line) + ": control character in a YAML text file");
 		line_start = false;
