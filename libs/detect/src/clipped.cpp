@@ -232,11 +232,12 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 {
 	// Sample i covers [x0 + i - 1/2, x0 + i + 1/2]: neighbours share a
-	// boundary, so count + 1 evaluations of Phi and phi serve all.
+	// boundary, so count + 1 evaluations of Phi and phi serve all. The
+	// integral of Phi is z Phi(z) + phi(z).
 	double zm = (x0 - 0.5) / sigma, Pm = Phi(zm), fm = phi(zm);
 	for (int i = 0; i < count; ++i)
 	{
-		const double zp = zm + 1 / sigma, Pp = Phi(zp), fp = phi(zp);
+		const double zp = (x0 + i + 0.5) / sigma, Pp = Phi(zp), fp = phi(zp);
 		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
 		zm = zp;
 		Pm = Pp;
@@ -246,10 +247,17 @@ void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 
 PixelStep pixelStep(double x, double sigma)
 {
-	// The integral of Phi is z Phi(z) + phi(z).
-	const double zp = (x + 0.5) / sigma, zm = (x - 0.5) / sigma;
-	const double Pp = Phi(zp), Pm = Phi(zm), fp = phi(zp), fm = phi(zm);
-	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+	PixelStep s;
+	pixelSteps(x, sigma, 1, &s);
+	return s;
+}
+
+int steepestRise(const int* v, int lo, int hi)
+{
+	int k = lo;
+	for (int i = lo + 1; i <= hi; ++i)
+		if (v[i + 1] - v[i - 1] > v[k + 1] - v[k - 1]) k = i;
+	return k;
 }
 
 ClippedFill clippedFill(const std::vector<int>& g_profiles, int n, int i0, int i1)
@@ -471,9 +479,7 @@ std::optional<ChannelFillLevel> fillLevelFromChannels(
 	{
 		const int* g = g_profiles.data() + size_t(j) * n;
 		const int* rb = rb_profiles.data() + size_t(j) * n;
-		int k = lo;
-		for (int i = lo + 1; i <= hi; ++i)
-			if (g[i + 1] - g[i - 1] > g[k + 1] - g[k - 1]) k = i;
+		const int k = steepestRise(g, lo, hi);
 		peak[j] = k;
 		g_frame.push_back(g[k - 2]);
 		rb_frame.push_back(-rb[k - 2]);

@@ -157,6 +157,11 @@ PixelStep pixelStep(double x, double sigma);
  * and density instead of 2 count). */
 void pixelSteps(double x0, double sigma, int count, PixelStep* out);
 
+/** The index in lo..hi (1 <= lo, hi <= n - 2) of the largest central
+ * difference v[i + 1] - v[i - 1], the first of equals: an edge's steepest
+ * rise. */
+int steepestRise(const int* v, int lo, int hi);
+
 /** Sub-pixel position of a step edge on a 1D profile, from the derivative
  * (values[k+1] - values[k-1]) around its largest value within [lo, hi]
  * (indices), the edge rising in the direction of increasing index. Nullopt

@@ -127,9 +127,7 @@ std::optional<double> locateRisingEdge(
 	if (lo > hi) return std::nullopt;
 	// Central difference, twice the slope [grey levels / px].
 	auto d = [&](int k) { return v[k + 1] - v[k - 1]; };
-	int peak = lo;
-	for (int k = lo + 1; k <= hi; ++k)
-		if (d(k) > d(peak)) peak = k;
+	const int peak = steepestRise(v, lo, hi);
 	const int dp = d(peak);
 	if (dp < 2 * min_rise) return std::nullopt;
 	const bool at_peak = mode == EdgeMode::Peak;
@@ -366,9 +364,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 				// Clipped: G reaches the sensor's top within two samples of
 				// its steepest point, where the peak fit reads it.
 				const int* gp = g_prof.data() + (g_prof.size() - n);
-				int k = lo;
-				for (int i = lo + 1; i <= hi; ++i)
-					if (gp[i + 1] - gp[i - 1] > gp[k + 1] - gp[k - 1]) k = i;
+				const int k = steepestRise(gp, lo, hi);
 				clipped += gp[std::min(n - 1, k + 2)] >= 254;
 			}
 			pos.push_back(s);
