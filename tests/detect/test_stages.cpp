@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 
 using namespace codemark;
@@ -409,6 +410,101 @@ TEST(Subpixel, PeakModeStepModelLocatesSharpAndBlurredSteps)
 		{
 			EXPECT_GT(worst_gauss, 3 * worst_model) << "sigma " << sigma;
 		}
+	}
+}
+
+namespace
+{
+/** Noise-free sharp profiles, the frame at \a lo and the fill at \a hi
+ * (real levels, rounded in each sample), the edge at e0 + slope j in
+ * profile j of \a m, and their edges as locateRisingEdge() reads them. */
+struct SharpSide
+{
+	std::vector<int> g, along;
+	std::vector<double> offset;
+	std::vector<std::optional<double>> edges;
+};
+SharpSide sharpSide(double lo, double hi, double e0, double slope, int m, int n, double noise = 0)
+{
+	SharpSide side;
+	std::mt19937 rng(3);
+	std::normal_distribution<double> gauss(0, noise);
+	for (int j = 0; j < m; ++j)
+	{
+		for (int i = 0; i < n; ++i)
+		{
+			const double f = std::clamp(i + 0.5 - (e0 + slope * j), 0.0, 1.0);
+			const double v = lo + (hi - lo) * f + (noise > 0 ? gauss(rng) : 0);
+			side.g.push_back(static_cast<int>(std::clamp(std::lround(v), 0L, 255L)));
+		}
+		side.along.push_back(j);
+		side.offset.push_back(0);
+		side.edges.push_back(locateRisingEdge(
+			side.g.data() + size_t(j) * n, n, 7, 13, 5, SubpixelParams(), EdgeMode::Peak));
+	}
+	return side;
+}
+/** The error of the slope of the least-squares line through the edges, as
+ * a distance across the side [px]. */
+double tiltError(const SharpSide& side, double slope)
+{
+	double sx = 0, sy = 0, sxx = 0, sxy = 0;
+	const int m = static_cast<int>(side.edges.size());
+	for (int j = 0; j < m; ++j)
+	{
+		sx += j;
+		sy += *side.edges[j];
+		sxx += double(j) * j;
+		sxy += j * *side.edges[j];
+	}
+	return ((m * sxy - sx * sy) / (m * sxx - sx * sx) - slope) * (m - 1);
+}
+}  // namespace
+
+// A noise-free sharp side's frame and fill levels are rounded once for all
+// its profiles (22.4 and 229.6 read 22 and 230: the contrast is 0.8 levels
+// too high), which tilts its line where the edge crosses a pixel boundary.
+// correctLevelRounding() reads each edge from its mixed pixel exactly and
+// fits that rounding with the line. Over frame and fill levels that round
+// up and down, edges crossing a pixel boundary anywhere along the side, and
+// slopes from near-aligned to steep, the line's tilt error falls (RMS) at
+// every slope. Noise, or two fill levels along the side, switch it off.
+TEST(Subpixel, LevelRoundingOfANoiseFreeSharpSideIsFitted)
+{
+	constexpr int m = 60, n = 21;
+	for (const double slope : {0.0005, 0.001, 0.002, 0.005, 0.01, 0.05})
+	{
+		double before = 0, after = 0;
+		int cases = 0;
+		for (const double lo : {22.4, 22.5001, 24.8})
+			for (const double hi : {229.6, 229.4999, 231.3, 254.7})
+				for (double at = 0.1; at < 0.95; at += 0.1)
+				{
+					SharpSide side = sharpSide(lo, hi, 10.5 - slope * m * at, slope, m, n);
+					before += std::pow(tiltError(side, slope), 2);
+					const auto c =
+						correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges);
+					ASSERT_TRUE(c) << lo << " " << hi;
+					EXPECT_LE(std::abs(*c), 1.0);
+					after += std::pow(tiltError(side, slope), 2);
+					++cases;
+				}
+		before = std::sqrt(before / cases);
+		after = std::sqrt(after / cases);
+		std::printf("edge slope %.4f: line tilt RMS %.4f -> %.4f px\n", slope, before, after);
+		EXPECT_LT(after, 0.85 * before) << "slope " << slope;
+	}
+	// Noise: each profile's rounding is its own.
+	{
+		SharpSide side = sharpSide(22.4, 229.6, 10.2, 0.01, m, n, 1.0);
+		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges));
+	}
+	// The fill brighter along half of the side: two roundings.
+	{
+		SharpSide side = sharpSide(22.4, 229.6, 10.2, 0.01, m, n);
+		const SharpSide other = sharpSide(22.4, 240.2, 10.2, 0.01, m, n);
+		std::copy(other.g.begin() + (m / 2) * n, other.g.end(), side.g.begin() + (m / 2) * n);
+		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges));
 	}
 }
 

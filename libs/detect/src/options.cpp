@@ -75,6 +75,7 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.min_frame_px_centroid", o.subpixel.min_frame_px_centroid);
 	f("subpixel.model_outer_edge", o.subpixel.model_outer_edge);
 	f("subpixel.step_model_peak", o.subpixel.step_model_peak);
+	f("subpixel.correct_level_rounding", o.subpixel.correct_level_rounding);
 	f("subpixel.model_clipping", o.subpixel.model_clipping);
 	f("subpixel.clipped_fraction", o.subpixel.clipped_fraction);
 	f("subpixel.min_rise_rb", o.subpixel.min_rise_rb);

@@ -172,6 +172,31 @@ std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
 	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
 
+/** A noise-free side's edges corrected for the rounding of its levels.
+ * Where the sensor is quiet and the edge sharp, each profile holds one
+ * mixed sample v between the frame's level L and the fill's H, and the
+ * edge sits at its pixel's boundary less f = (v - L) / (H - L). L and H
+ * are rounded once for the whole side (a fill rendered or lit at 229.5
+ * reads 230 in every profile), so the contrast's rounding c (within +-1
+ * level) moves each edge by f c / (H - L): a sawtooth along a side whose
+ * edge crosses a pixel boundary, which tilts its line (0.0045 px across a
+ * side at 2 m: 1.2e-3 rad of phi2). This fits c with the side's line
+ * (least squares, each mixed sample's own rounding the noise, c's prior,
+ * the difference of two roundings, a Gaussian of variance 1/6), and sets
+ * each such profile's edge in \a edges [profile index] to the pixel's
+ * boundary less f (1 - c / (H - L)): the exact reading of a sharp edge,
+ * which the three-sample step fit approaches to 0.001 px only. Profile
+ * j's across coordinate is \a offset[j] + \a inward x edge, along
+ * \a along[j]. Applies only where at least 10 profiles and 80% of those
+ * with an edge are sharp (L twice before the mixed sample, H twice after)
+ * with one L and one H at least 20 levels apart: noise breaks that
+ * pattern, and there each profile's rounding is its own. Returns c [grey
+ * levels] or nullopt (edges unchanged). Written by hand: the model is
+ * this detector's. */
+std::optional<double> correctLevelRounding(
+	const std::vector<int>& g_profiles, int n, const std::vector<int>& along,
+	const std::vector<double>& offset, int inward, std::vector<std::optional<double>>& edges);
+
 /** The profiles of one side, for imputeClippedSide(): sample i of profile
  * j lies at across coordinate base[j] + inward * i (i grows into the fill)
  * and along coordinate along[j] of \a image (rows: along is the row,

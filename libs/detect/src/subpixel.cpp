@@ -207,6 +207,70 @@ std::optional<double> locateRisingEdge(
 	return s1 / s0;
 }
 
+std::optional<double> correctLevelRounding(
+	const std::vector<int>& g_profiles, int n, const std::vector<int>& along,
+	const std::vector<double>& offset, int inward, std::vector<std::optional<double>>& edges)
+{
+	constexpr int kMinSharp = 10;
+	constexpr double kMinSharpShare = 0.8;
+	constexpr int kMinContrast = 20;
+	struct Sharp
+	{
+		size_t j;
+		int m, v;
+	};
+	std::vector<Sharp> sharp;
+	int with_edge = 0, L = -1, H = -1;
+	for (size_t j = 0; j < edges.size(); ++j)
+	{
+		if (!edges[j]) continue;
+		++with_edge;
+		const int m = static_cast<int>(std::lround(*edges[j]));
+		if (m < 2 || m + 2 >= n) continue;
+		const int* v = g_profiles.data() + j * n;
+		if (v[m - 2] != v[m - 1] || v[m + 1] != v[m + 2] || v[m] < v[m - 1] || v[m] > v[m + 1])
+			continue;
+		if (L < 0)
+		{
+			L = v[m - 1];
+			H = v[m + 1];
+		}
+		if (v[m - 1] != L || v[m + 1] != H) return std::nullopt;  // two levels: not one rounding
+		sharp.push_back({j, m, v[m]});
+	}
+	const int count = static_cast<int>(sharp.size());
+	if (count < kMinSharp || count < kMinSharpShare * with_edge || H - L < kMinContrast)
+		return std::nullopt;
+	const double A = H - L;
+	// Unknowns: the line's intercept and slope (along centred) and c.
+	// Weights in grey levels: a mixed sample's rounding has variance 1/12,
+	// c's prior (the difference of two uniform roundings) 1/6.
+	double mean_s = 0;
+	for (const auto& k : sharp) mean_s += along[k.j];
+	mean_s /= count;
+	Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+	Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+	for (const auto& k : sharp)
+	{
+		const double f = (k.v - L) / A;
+		// The sharp edge's own estimate: the pixel's boundary less f.
+		const double c = offset[k.j] + inward * (k.m + 0.5 - f);
+		const Eigen::Vector3d phi(1, along[k.j] - mean_s, -inward * f / A);
+		M += phi * phi.transpose();
+		rhs += phi * c;
+	}
+	M *= 12 * A * A;
+	rhs *= 12 * A * A;
+	M(2, 2) += 6;
+	const double c_level = std::clamp(M.ldlt().solve(rhs)[2], -1.0, 1.0);
+	for (const auto& k : sharp)
+	{
+		const double f = (k.v - L) / A;
+		edges[k.j] = k.m + 0.5 - f + f * c_level / A;
+	}
+	return c_level;
+}
+
 namespace
 {
 bool fitTls(const std::vector<Eigen::Vector2d>& pts, const std::vector<char>& keep, LineFit& f)
@@ -522,6 +586,14 @@ std::optional<RefinedQuad> refineQuadrangle(
 				imputeFillLevel(g_prof, n, *level);
 				locateAll(false);
 			}
+		}
+		// G read as it is (nothing imputed): on a noise-free sharp side, the
+		// levels' rounding is one for all its edges.
+		if (p.correct_level_rounding && !clips && !all_clipped)
+		{
+			std::vector<double> offset(origin.size());
+			for (size_t j = 0; j < origin.size(); ++j) offset[j] = origin[j] - inward * half;
+			correctLevelRounding(g_prof, n, pos, offset, inward, edges);
 		}
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());

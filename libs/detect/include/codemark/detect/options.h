@@ -180,6 +180,11 @@ struct SubpixelParams
 	 * the three samples) instead of the log-parabola's Gaussian, which
 	 * errs with the edge's phase in its pixel on sharp edges. */
 	bool step_model_peak = true;
+	/** On a noise-free sharp side (one mixed sample a profile between
+	 * levels shared by all of them), fit the rounding of the levels' contrast
+	 * with the line: it is one for the whole side and tilts the line where
+	 * the edge crosses a pixel boundary. Noisy images never qualify. */
+	bool correct_level_rounding = true;
 	/** Smallest slope of R + B accepted on a saturated profile [grey levels
 	 * per px]. */
 	double min_rise_rb = 4;
