@@ -134,3 +134,16 @@ TEST(BadFiles, YamlDirectivesTabsAndControlCharactersAreRefused)
 	const std::string t = errorOf([&] { CameraModel::load(tabbed); });
 	EXPECT_NE(t.find(tabbed + ":3: tab character"), std::string::npos) << t;
 }
+
+TEST(BadFiles, OpenCvYamlThatHangsOpenCvsReaderIsRefused)
+{
+	// OpenCV 4.6's YAML reader loops forever on a document start with text
+	// after it and a later '---' (fuzz_camera); camera files never hold one.
+	const auto doc = writeTemp("doc_start.yaml", "%YAML:1.0\n---a:0\n1---\n");
+	const std::string e = errorOf([&] { CameraModel::load(doc); });
+	EXPECT_NE(e.find(doc + ":2: text after the document start"), std::string::npos) << e;
+	const auto control =
+		writeTemp("control_cv.yaml", std::string("%YAML:1.0\n---\nimage_width: 6\0\n", 30));
+	const std::string c = errorOf([&] { CameraModel::load(control); });
+	EXPECT_NE(c.find(control + ":3: control character"), std::string::npos) << c;
+}

@@ -68,8 +68,40 @@ bool startsWithOpenCvYaml(const std::string& path)
 	return first.rfind("%YAML:", 0) == 0 || all.str().find("!!opencv-matrix") != std::string::npos;
 }
 
+/** Refuses what no OpenCV camera YAML holds but makes OpenCV 4.6's YAML
+ * reader (cv::FileStorage) loop forever, found by fuzzing: a document
+ * start '---' with text after it on its line, followed by a line that
+ * holds '---' ("%YAML:1.0\n---a:0\n1---\n"). Such files, as OpenCV and
+ * camera calibration tools write them, start a document with a bare
+ * '---' line; they hold no control characters either. Say so instead of
+ * hanging. */
+void requireOpenCvYamlText(const std::string& path)
+{
+	std::ifstream in(path, std::ios::binary);
+	std::string text_line;
+	int line = 0;
+	while (std::getline(in, text_line))
+	{
+		++line;
+		if (!text_line.empty() && text_line.back() == '\r') text_line.pop_back();
+		for (const char ch : text_line)
+		{
+			const auto u = static_cast<unsigned char>(ch);
+			if ((u < 0x20 && u != '\t') || u == 0x7f)
+				throw std::runtime_error(
+					path + ":" + std::to_string(line) + ": control character in a YAML text file");
+		}
+		if (text_line.rfind("---", 0) == 0 &&
+			text_line.find_first_not_of(" \t", 3) != std::string::npos)
+			throw std::runtime_error(
+				path + ":" + std::to_string(line) +
+				": text after the document start '---' (expected '---' alone on its line)");
+	}
+}
+
 mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 {
+	requireOpenCvYamlText(path);
 	cv::FileStorage fs;
 	try
 	{
