@@ -12,6 +12,7 @@
 #include <codemark/landmark/camera.h>
 #include <codemark/pose/measurement.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -68,6 +69,15 @@ struct MethodErrors
 	 * sigma is at most 2 deg (where a Gaussian C_R can hold). */
 	double nees_small_phi2_sum = 0;
 	int nees_small_phi2_n = 0;
+	/** Standard errors of the seven means above (l2, phi1, phi2, x, y,
+	 * theta, position), from the spread of |error| over the renders
+	 * (infinite with under two detections); \a sum_sq accumulates. */
+	std::array<double, 7> se{}, sum_sq{};
+	/** The seven means in that order. */
+	std::array<double, 7> means() const
+	{
+		return {l2_m, phi1_rad, phi2_rad, x_m, y_m, theta_rad, position_m};
+	}
 };
 
 /** One grid cell. */
