@@ -261,7 +261,7 @@ std::vector<CellResult> runSurvey(
 	ro.noise_sigma = o.noise_sigma;
 	ro.blur_sigma_px = o.blur_sigma_px;
 	const LandmarkGeometry g = lm.geometry();
-	const detect::DetectorOptions dopt;
+	const detect::DetectorOptions& dopt = o.detector;
 	pose::PoseOptions cf = o.pose, gen = o.pose;
 	cf.method = pose::PoseMethod::ClosedForm;
 	gen.method = pose::PoseMethod::General6Dof;

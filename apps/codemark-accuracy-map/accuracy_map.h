@@ -9,6 +9,7 @@
  * Kept beside the tool because it needs both the renderer and the detector,
  * which the pose library must not depend on.
  */
+#include <codemark/detect/options.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/pose/measurement.h>
 
@@ -36,6 +37,8 @@ struct SurveyOptions
 	pose::PoseOptions pose;
 	/** A one-line description of \a pose's noise model for the summary. */
 	std::string noise_label = "calibrated (pipeline::detectorCalibratedPoseOptions)";
+	/** codemark's detector settings (--detector-config). */
+	detect::DetectorOptions detector;
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path
 	/** Render codemark's landmark in the realistic scene of the C_P
 	 * calibration and the simulated datasets (sim::DatasetOptions::

@@ -28,6 +28,11 @@ int main(int argc, char** argv)
 			' ', "0.1.0");
 		TCLAP::ValueArg<std::string> out_arg(
 			"", "out", "Output folder (created).", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> detector_arg(
+			"", "detector-config",
+			"codemark's detector options (share/codemark/detector.ini's format). Default: the "
+			"built-in defaults.",
+			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> camera_arg(
 			"", "camera",
 			"Camera file (MRPT ini or YAML). Default: the paper's camera. The AprilTag column "
@@ -117,6 +122,8 @@ int main(int argc, char** argv)
 			o.noise_label = "constant sigma_px " + std::to_string(sigma_arg.getValue());
 		}
 		o.apriltag = !no_tag_arg.getValue();
+		if (!detector_arg.getValue().empty())
+			o.detector = codemark::detect::DetectorOptions::load(detector_arg.getValue());
 		if (paper_arg.getValue()) o.pose.refine_on_primary = false;
 		o.realistic = realistic_arg.getValue();
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());

@@ -510,6 +510,80 @@ TEST(Subpixel, LevelRoundingOfANoiseFreeSharpSideIsFitted)
 
 namespace
 {
+/** Noisy profiles across a thin frame as a camera sees the print: a grey
+ * wall, the sheet's quiet margin (\a margin px), the black frame (\a frame
+ * px), the green fill; blur 0.8 px, noise 2; the inner edge at 10 + slope j
+ * in profile j of 60. */
+void thinFrameProfiles(
+	double frame, double margin, double slope, std::vector<int>& g, std::vector<double>& truth,
+	int n)
+{
+	constexpr double W = 128, M = 235, K = 25, G = 240, sigma = 0.8;
+	std::mt19937 rng(11);
+	std::normal_distribution<double> noise(0, 2);
+	g.clear();
+	truth.clear();
+	for (int j = 0; j < 60; ++j)
+	{
+		const double e = 10 + slope * j;
+		truth.push_back(e);
+		for (int i = 0; i < n; ++i)
+		{
+			const double v = W + (M - W) * pixelStep(i - (e - frame - margin), sigma).value +
+							 (K - M) * pixelStep(i - (e - frame), sigma).value +
+							 (G - K) * pixelStep(i - e, sigma).value + noise(rng);
+			g.push_back(static_cast<int>(std::clamp(std::lround(v), 0L, 255L)));
+		}
+	}
+}
+}  // namespace
+
+// A thin frame's peak-model edges lie inwards where the quiet margin is
+// under a pixel (the wall's edge to it cancels part of the frame's lobe);
+// thinFrameOffset() measures that shift from all the side's profiles with
+// a model of the whole print. Slanted sides (phases across the pixel) fit
+// the blur too; a side along the grid takes one. On a wide margin the peak
+// model is right and the offset stays near 0.
+TEST(Subpixel, ThinFrameOffsetRemovesTheNarrowMarginsPull)
+{
+	constexpr int n = 21;
+	std::vector<int> g;
+	std::vector<double> truth;
+	for (const double frame : {2.4, 2.7, 3.0})
+		for (const double slope : {0.013, 0.0})
+		{
+			const double sigma = slope > 0 ? 0 : 0.8;
+			for (const double margin : {0.66, 5.0})
+			{
+				thinFrameProfiles(frame, margin, slope, g, truth, n);
+				std::vector<std::optional<double>> edges;
+				double before = 0;
+				for (int j = 0; j < 60; ++j)
+				{
+					edges.push_back(locateRisingEdge(
+						g.data() + j * n, n, 7, 13, 5, SubpixelParams(), EdgeMode::Peak, frame));
+					ASSERT_TRUE(edges.back());
+					before += (*edges.back() - truth[j]) / 60;
+				}
+				const auto offset = thinFrameOffset(g, n, edges, frame, sigma);
+				ASSERT_TRUE(offset) << frame << " " << margin << " " << slope;
+				const double after = before + *offset;
+				std::printf(
+					"frame %.1f px, margin %.2f px, %s: edges' mean error %+.4f -> %+.4f px\n",
+					frame, margin, slope > 0 ? "slanted" : "along the grid", before, after);
+				if (margin < 1)
+				{
+					EXPECT_GT(before, 0.02);
+					EXPECT_LT(std::abs(after), 0.5 * before);
+				}
+				else
+					EXPECT_LT(std::abs(after), std::abs(before) + 0.01);
+			}
+		}
+}
+
+namespace
+{
 /** Profiles across a sharp inner edge as the renderer makes them: frame G
  * 25 and B + R 50, fill G = \a level clipped at 255 and B + R 0 (B and R
  * rounded alike), the edge at \a e0 + \a slope j in profile j of \a m. */

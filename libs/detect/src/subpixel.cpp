@@ -19,6 +19,10 @@ constexpr int kMinFillSamples = 20;
 constexpr double kQuietNoise = 0.5;
 /** G's own rounding on an edge of the spec's contrast (230 levels) [px]. */
 constexpr double kGRoundingPx = 0.5 / 230;
+/** thinFrameOffset() on frames at least this wide [px], the blur it shares
+ * from frames at least this wide. */
+constexpr double kMinThinModelPx = 2.0;
+constexpr double kMinBlurFramePx = 2.5;
 /** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
@@ -271,6 +275,160 @@ std::optional<double> correctLevelRounding(
 	return c_level;
 }
 
+std::optional<double> thinFrameOffset(
+	const std::vector<int>& g_profiles, int n, const std::vector<std::optional<double>>& edges,
+	double frame_px, double fixed_sigma, double* sigma_out)
+{
+	constexpr double kBin = 0.25, kInside = 3.0, kBeyond = 4.0;
+	const double x0 = -(frame_px + kBeyond);
+	const int bins = static_cast<int>(std::ceil((kInside - x0) / kBin));
+	std::vector<double> sum(bins, 0.0), sum_x(bins, 0.0);
+	std::vector<int> count(bins, 0);
+	int used = 0;
+	for (size_t j = 0; j < edges.size(); ++j)
+	{
+		if (!edges[j]) continue;
+		++used;
+		const int* v = g_profiles.data() + j * n;
+		for (int i = std::max(0, static_cast<int>(std::ceil(*edges[j] + x0)));
+			 i <= std::min(n - 1, static_cast<int>(std::floor(*edges[j] + kInside))); ++i)
+		{
+			const int b = static_cast<int>((i - *edges[j] - x0) / kBin);
+			if (b < 0 || b >= bins) continue;
+			sum[b] += v[i];
+			sum_x[b] += i - *edges[j];
+			++count[b];
+		}
+	}
+	if (used < 8) return std::nullopt;
+	struct Bin
+	{
+		double x, v, w;
+	};
+	std::vector<Bin> data;
+	for (int b = 0; b < bins; ++b)
+		if (count[b] > 0)
+			data.push_back({sum_x[b] / count[b], sum[b] / count[b], double(count[b])});
+	// Without a blur to hold, the profiles' phases must spread over the
+	// pixel (a side slanting across the grid); one phase gives a sample a
+	// pixel, too few for the blur as well.
+	if (data.size() < (fixed_sigma > 0 ? 9u : 16u)) return std::nullopt;
+	// p: W, M, K, G, sigma, frame width, margin width, inner offset.
+	using Vec8 = Eigen::Matrix<double, 8, 1>;
+	using Mat8 = Eigen::Matrix<double, 8, 8>;
+	const auto levelOver = [&](double lo, double hi, bool take_max, bool take_min)
+	{
+		double acc = 0, w = 0, best = take_max ? -1e9 : 1e9;
+		for (const Bin& d : data)
+			if (d.x >= lo && d.x <= hi)
+			{
+				acc += d.v * d.w;
+				w += d.w;
+				best = take_max ? std::max(best, d.v) : std::min(best, d.v);
+			}
+		if (w == 0) return std::optional<double>();
+		return std::optional<double>(take_max || take_min ? best : acc / w);
+	};
+	const auto K0 = levelOver(-frame_px, 0, false, true);
+	const auto G0 = levelOver(1.5, kInside, false, false);
+	const auto M0 = levelOver(-frame_px - 3, -frame_px + 0.5, true, false);
+	if (!K0 || !G0 || !M0) return std::nullopt;
+	const auto W0 = levelOver(x0, -frame_px - 3, false, false);
+	Vec8 q;
+	q << W0.value_or(*M0), *M0, *K0, *G0, fixed_sigma > 0 ? fixed_sigma : 0.8, frame_px, 1.0, 0.0;
+	const auto clampParams = [&](Vec8& t)
+	{
+		t[4] = std::clamp(t[4], 0.2, 2.5);
+		t[5] = frame_px;
+		if (fixed_sigma > 0) t[4] = fixed_sigma;
+		// The sheet's white above the frame's black, the fill above it too.
+		t[1] = std::max(t[1], t[2] + 10);
+		t[3] = std::max(t[3], t[2] + 10);
+		t[6] = std::clamp(t[6], 0.25 * frame_px, kBeyond);
+		t[7] = std::clamp(t[7], -1.0, 1.0);
+	};
+	const auto residuals = [&](const Vec8& t, Mat8* JtJ, Vec8* Jtr)
+	{
+		double cost = 0;
+		if (JtJ) JtJ->setZero();
+		if (Jtr) Jtr->setZero();
+		for (const Bin& d : data)
+		{
+			// The frame's and the margin's edges move with the inner one.
+			const double x = d.x - t[7];
+			const PixelStep s1 = pixelStep(x + t[5] + t[6], t[4]), s2 = pixelStep(x + t[5], t[4]),
+							s3 = pixelStep(x, t[4]);
+			const double W = t[0], M = t[1], K = t[2], G = t[3];
+			const double model = W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value;
+			const double r = model - d.v;
+			cost += d.w * r * r;
+			if (JtJ)
+			{
+				Vec8 J;
+				J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
+					fixed_sigma > 0
+						? 0.0
+						: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
+					0.0, (M - W) * s1.d_x,
+					-((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
+				*JtJ += d.w * J * J.transpose();
+				*Jtr += d.w * r * J;
+			}
+		}
+		return cost;
+	};
+	Mat8 H;
+	Vec8 g;
+	double cost = residuals(q, &H, &g), mu = 1e-3;
+	bool converged = false;
+	for (int it = 0; it < 40 && !converged; ++it)
+	{
+		Mat8 A = H;
+		A.diagonal() += mu * H.diagonal().cwiseMax(1e-9);
+		Vec8 cand = q - A.ldlt().solve(g);
+		if (!cand.allFinite()) return std::nullopt;
+		clampParams(cand);
+		Mat8 Hc;
+		Vec8 gc;
+		const double cc = residuals(cand, &Hc, &gc);
+		if (cc < cost)
+		{
+			converged = std::abs(cand[7] - q[7]) < 1e-4 && cost - cc < 1e-8 * cost;
+			q = cand;
+			cost = cc;
+			H = Hc;
+			g = gc;
+			mu = std::max(1e-9, mu * 0.3);
+		}
+		else
+		{
+			mu *= 10;
+			converged = mu > 1e6;
+		}
+	}
+	if (std::abs(q[7]) > 0.5) return std::nullopt;
+	// The offset's standard error (the bins' residual variance, the frame
+	// width held), and the offset shrunk by it: d^2 / (d^2 + se^2) of it,
+	// so that sides whose profiles show no shift (a wide margin, a frame
+	// over 4 px) keep their edges rather than take the fit's noise.
+	// Held parameters (the frame's width, the blur if given) leave the
+	// inverse through unit diagonals.
+	Mat8 Hf = H;
+	for (const int k : {4, 5})
+		if (k == 5 || fixed_sigma > 0)
+		{
+			Hf.row(k).setZero();
+			Hf.col(k).setZero();
+			Hf(k, k) = 1;
+		}
+	const double dof = std::max(1.0, double(data.size()) - (fixed_sigma > 0 ? 6 : 7));
+	const double var = (cost / dof) * Hf.inverse()(7, 7);
+	if (!(var >= 0)) return std::nullopt;
+	if (sigma_out) *sigma_out = q[4];
+	const double d2 = q[7] * q[7];
+	return q[7] * d2 / (d2 + var);
+}
+
 namespace
 {
 bool fitTls(const std::vector<Eigen::Vector2d>& pts, const std::vector<char>& keep, LineFit& f)
@@ -367,6 +525,14 @@ std::optional<RefinedQuad> refineQuadrangle(
 	std::array<bool, 4> undecided{}, channels_agree{};
 	SubpixelParams p_centring = p;
 	p_centring.step_model_peak = false;
+	// Thin sides' profiles and edges for thinFrameOffset().
+	struct ThinSide
+	{
+		std::vector<int> g;
+		std::vector<std::optional<double>> edges;
+		int n, inward, across;
+	};
+	std::array<std::optional<ThinSide>, 4> thin;
 	const auto refineSide = [&](int side, bool retry) -> bool
 	{
 		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
@@ -587,6 +753,11 @@ std::optional<RefinedQuad> refineQuadrangle(
 				locateAll(false);
 			}
 		}
+		// A thin frame (Peak mode) read in G: kept for the side's model
+		// below, once all four lines give the frame's width.
+		thin[side].reset();
+		if (p.thin_frame_model && mode == EdgeMode::Peak && !side_saturated && !all_clipped)
+			thin[side] = ThinSide{g_prof, edges, n, inward, across};
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
 		// levels' rounding is one for all its edges.
 		if (p.correct_level_rounding && !clips && !all_clipped)
@@ -626,6 +797,87 @@ std::optional<RefinedQuad> refineQuadrangle(
 		if (undecided[side] && (some_at_top || channels_agree[side]) && !refineSide(side, true))
 			return std::nullopt;
 	// Corner k = side k-1 x side k (TL = left x top, ...).
+	const auto intersect = [&](int k) -> std::optional<Eigen::Vector2d>
+	{
+		const LineFit& l1 = out.sides[(k + 3) % 4];
+		const LineFit& l2 = out.sides[k];
+		const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
+									  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
+		if (std::abs(h.z()) < 1e-9) return std::nullopt;
+		return Eigen::Vector2d(h.head<2>() / h.z());
+	};
+	if (std::any_of(thin.begin(), thin.end(), [](const auto& t) { return t.has_value(); }))
+	{
+		// The thin sides' model of the print (thinFrameOffset()): the
+		// frame's width across each from the refined square's homography
+		// (the ratio of the sides' lengths goes as the depth, a
+		// foreshortened width as its square), one blur for the landmark,
+		// fitted first on sides whose profiles' phases spread over the pixel.
+		Quad refined;
+		bool ok = true;
+		for (int k = 0; k < 4 && ok; ++k)
+		{
+			const auto c = intersect(k);
+			ok = c.has_value();
+			if (ok) refined[k] = *c;
+		}
+		if (ok)
+		{
+			static const std::array<Eigen::Vector2d, 4> kFace{
+				Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1),
+				Eigen::Vector2d(-1, -1)};
+			const Eigen::Matrix3d H = faceToImage(refined);
+			const auto toPixel = [&](const Eigen::Vector2d& f)
+			{
+				const Eigen::Vector3d q = H * Eigen::Vector3d(f.x(), f.y(), 1);
+				return Eigen::Vector2d(q.head<2>() / q.z());
+			};
+			std::vector<double> sigmas;
+			std::array<double, 4> offsets{};
+			std::array<bool, 4> done{};
+			for (const bool hold : {false, true})
+			{
+				double sigma = 0;
+				if (hold)
+				{
+					if (sigmas.empty()) break;
+					std::nth_element(
+						sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+					sigma = sigmas[sigmas.size() / 2];
+				}
+				for (int side = 0; side < 4; ++side)
+				{
+					if (!thin[side] || done[side]) continue;
+					const ThinSide& t = *thin[side];
+					const Eigen::Vector2d f0 = kFace[side], f1 = kFace[(side + 1) % 4];
+					const Eigen::Vector2d in = 0.5 * (f0 + f1),
+										  outer = in + frame_ratio * (f0 + f1);
+					const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
+					// Under 2 px the frame never reaches its black: the
+					// model cannot tell it from the margin (the fit's levels
+					// and blur wander), and the peak model's edges stay.
+					if (width < kMinThinModelPx) continue;
+					double fitted_sigma = 0;
+					if (const auto d =
+							thinFrameOffset(t.g, t.n, t.edges, width, sigma, &fitted_sigma))
+					{
+						offsets[side] = *d;
+						done[side] = true;
+						if (!hold && width >= kMinBlurFramePx) sigmas.push_back(fitted_sigma);
+					}
+				}
+			}
+			// Each edge moves by the offset along its profile: the line by
+			// as much across (undistorted and raw pixels differ by the
+			// distortion's scale there, a few percent of a small shift).
+			for (int side = 0; side < 4; ++side)
+				if (done[side])
+				{
+					LineFit& l = out.sides[side];
+					l.c -= l.normal(thin[side]->across) * thin[side]->inward * offsets[side];
+				}
+		}
+	}
 	for (int k = 0; k < 4; ++k)
 	{
 		const LineFit& l1 = out.sides[(k + 3) % 4];

@@ -175,6 +175,19 @@ struct SubpixelParams
 	 * lobe's tail pulls the peak inwards by 0.2-0.5 px when the frame is
 	 * 1.6-2.3 px wide (5 m at 45-60 deg). */
 	bool model_outer_edge = true;
+	/** ... and then shift each side whose frame is 2-6 px wide by the
+	 * offset that a fit of all its profiles together with a model of the
+	 * whole print across it (wall, quiet margin, frame, fill; the frame's
+	 * width from the refined square, one blur for the landmark) gives
+	 * (detect::thinFrameOffset()). The peak model knows the frame's outer
+	 * edge but not the margin's: where the spec's 5 mm margin is under a
+	 * pixel, the wall's edge to it cancels part of the frame's lobe, and
+	 * the edges lie 0.05-0.1 px inwards. Off by default until C_P is
+	 * calibrated for it: on the accuracy map it takes the position error
+	 * from 2 to 5 m from 30.2 to 21.8 mm, which leaves the shipped C_P
+	 * conservative (the simulated loops' EKF NEES 2.49, under its band;
+	 * docs/benchmarks/pose.md). */
+	bool thin_frame_model = false;
 	/** Refine the derivative's peak with the exact response of a
 	 * pixel-integrated Gaussian step (its position, blur and height from
 	 * the three samples) instead of the log-parabola's Gaussian, which
