@@ -880,12 +880,9 @@ std::optional<RefinedQuad> refineQuadrangle(
 	}
 	for (int k = 0; k < 4; ++k)
 	{
-		const LineFit& l1 = out.sides[(k + 3) % 4];
-		const LineFit& l2 = out.sides[k];
-		const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
-									  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
-		if (std::abs(h.z()) < 1e-9) return std::nullopt;
-		out.corners_ideal[k] = h.head<2>() / h.z();
+		const auto corner = intersect(k);
+		if (!corner) return std::nullopt;
+		out.corners_ideal[k] = *corner;
 		if (distorted)
 		{
 			const Eigen::Vector2d xn(
