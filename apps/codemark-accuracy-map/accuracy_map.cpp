@@ -51,17 +51,17 @@ void accumulate(MethodErrors& e, const pose::Measurement& m, const SightingTruth
 		m.pose_in_landmark[1] - t.pose_in_landmark[1],
 		wrapToPi(m.pose_in_landmark[2] - t.pose_in_landmark[2]));
 	++e.detected;
-	e.l2_m += std::abs(dL[0]);
-	e.phi1_rad += std::abs(dL[1]);
-	e.phi2_rad += std::abs(dL[2]);
-	e.x_m += std::abs(dR[0]);
-	e.y_m += std::abs(dR[1]);
-	e.theta_rad += std::abs(dR[2]);
-	e.position_m += dR.head<2>().norm();
+	// MethodErrors::means()' order.
 	const std::array<double, 7> abs_err{std::abs(dL[0]),	std::abs(dL[1]), std::abs(dL[2]),
 										std::abs(dR[0]),	std::abs(dR[1]), std::abs(dR[2]),
 										dR.head<2>().norm()};
-	for (int k = 0; k < 7; ++k) e.sum_sq[k] += abs_err[k] * abs_err[k];
+	double* sums[7] = {&e.l2_m, &e.phi1_rad,  &e.phi2_rad,	&e.x_m,
+					   &e.y_m,	&e.theta_rad, &e.position_m};
+	for (int k = 0; k < 7; ++k)
+	{
+		*sums[k] += abs_err[k];
+		e.sum_sq[k] += abs_err[k] * abs_err[k];
+	}
 	const double nees = dR.dot(m.C_R.ldlt().solve(dR));
 	e.nees += nees;
 	e.nees_L += dL.dot(m.C_L.ldlt().solve(dL));

@@ -421,7 +421,7 @@ namespace
 struct SharpSide
 {
 	std::vector<int> g, along;
-	std::vector<double> offset;
+	std::vector<int> origin;  // all 0: the across coordinate is the edge
 	std::vector<std::optional<double>> edges;
 };
 SharpSide sharpSide(double lo, double hi, double e0, double slope, int m, int n, double noise = 0)
@@ -438,7 +438,7 @@ SharpSide sharpSide(double lo, double hi, double e0, double slope, int m, int n,
 			side.g.push_back(static_cast<int>(std::clamp(std::lround(v), 0L, 255L)));
 		}
 		side.along.push_back(j);
-		side.offset.push_back(0);
+		side.origin.push_back(0);
 		side.edges.push_back(locateRisingEdge(
 			side.g.data() + size_t(j) * n, n, 7, 13, 5, SubpixelParams(), EdgeMode::Peak));
 	}
@@ -483,7 +483,7 @@ TEST(Subpixel, LevelRoundingOfANoiseFreeSharpSideIsFitted)
 					SharpSide side = sharpSide(lo, hi, 10.5 - slope * m * at, slope, m, n);
 					before += std::pow(tiltError(side, slope), 2);
 					const auto c =
-						correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges);
+						correctLevelRounding(side.g, n, side.along, side.origin, 0, 1, side.edges);
 					ASSERT_TRUE(c) << lo << " " << hi;
 					EXPECT_LE(std::abs(*c), 1.0);
 					after += std::pow(tiltError(side, slope), 2);
@@ -497,14 +497,14 @@ TEST(Subpixel, LevelRoundingOfANoiseFreeSharpSideIsFitted)
 	// Noise: each profile's rounding is its own.
 	{
 		SharpSide side = sharpSide(22.4, 229.6, 10.2, 0.01, m, n, 1.0);
-		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges));
+		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.origin, 0, 1, side.edges));
 	}
 	// The fill brighter along half of the side: two roundings.
 	{
 		SharpSide side = sharpSide(22.4, 229.6, 10.2, 0.01, m, n);
 		const SharpSide other = sharpSide(22.4, 240.2, 10.2, 0.01, m, n);
 		std::copy(other.g.begin() + (m / 2) * n, other.g.end(), side.g.begin() + (m / 2) * n);
-		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.offset, 1, side.edges));
+		EXPECT_FALSE(correctLevelRounding(side.g, n, side.along, side.origin, 0, 1, side.edges));
 	}
 }
 

@@ -11,12 +11,12 @@ Eigen::Matrix3d faceToImage(const Quad& c)
 {
 	// Four-point DLT with h33 = 1 (the reference square is never degenerate
 	// here: linkQuadrangle checked convexity).
-	const double src[4][2] = {{-1, 1}, {1, 1}, {1, -1}, {-1, -1}};
+
 	Eigen::Matrix<double, 8, 8> A;
 	Eigen::Matrix<double, 8, 1> b;
 	for (int k = 0; k < 4; ++k)
 	{
-		const double x = src[k][0], y = src[k][1], u = c[k].x(), v = c[k].y();
+		const double x = kFaceCorners[k].x(), y = kFaceCorners[k].y(), u = c[k].x(), v = c[k].y();
 		A.row(2 * k) << x, y, 1, 0, 0, 0, -u * x, -u * y;
 		A.row(2 * k + 1) << 0, 0, 0, x, y, 1, -v * x, -v * y;
 		b(2 * k) = u;
@@ -44,22 +44,6 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v)
 
 namespace
 {
-/** Maps normalised face coordinates to raw pixels. */
-struct FaceMap
-{
-	Eigen::Matrix3d H;
-	const CameraModel& cam;
-	bool distorted;
-
-	Eigen::Vector2d operator()(double x, double y) const
-	{
-		const Eigen::Vector3d q = H * Eigen::Vector3d(x, y, 1);
-		const Eigen::Vector2d ideal = q.head<2>() / q.z();
-		if (!distorted) return ideal;
-		return cam.distortNormalized(
-			{(ideal.x() - cam.cx()) / cam.fx(), (ideal.y() - cam.cy()) / cam.fy()});
-	}
-};
 
 /** Mean G over a square patch of half-size \a r centred on (x, y) in
  * normalised face coordinates, on a 5 x 5 grid; nullopt if outside. */

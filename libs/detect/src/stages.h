@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Dense>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -186,8 +187,8 @@ std::optional<double> locateRisingEdge(
  * each such profile's edge in \a edges [profile index] to the pixel's
  * boundary less f (1 - c / (H - L)): the exact reading of a sharp edge,
  * which the three-sample step fit approaches to 0.001 px only. Profile
- * j's across coordinate is \a offset[j] + \a inward x edge, along
- * \a along[j]. Applies only where at least 10 profiles and 80% of those
+ * j's across coordinate is \a origin[j] + \a inward x (edge - \a half),
+ * along \a along[j]. Applies only where at least 10 profiles and 80% of those
  * with an edge are sharp (L twice before the mixed sample, H twice after)
  * with one L and one H at least 20 levels apart: noise breaks that
  * pattern, and there each profile's rounding is its own. Returns c [grey
@@ -195,7 +196,8 @@ std::optional<double> locateRisingEdge(
  * this detector's. */
 std::optional<double> correctLevelRounding(
 	const std::vector<int>& g_profiles, int n, const std::vector<int>& along,
-	const std::vector<double>& offset, int inward, std::vector<std::optional<double>>& edges);
+	const std::vector<int>& origin, int half, int inward,
+	std::vector<std::optional<double>>& edges);
 
 /** The mean offset [px] of a thin frame's inner edges from where the
  * peak model put them (\a edges, profile index; \a g_profiles of \a n
@@ -388,10 +390,33 @@ struct CodeReading
 	double margin = 0;	//!< smallest |cell - threshold| [grey levels]
 };
 
-/** Homography from normalised face coordinates (s/h right, t/h up; the
- * reference square is [-1, 1]^2) to ideal pixels, from corners TL, TR, BR,
- * BL. */
+/** The reference square's corners TL, TR, BR, BL in normalised face
+ * coordinates (s/h right, t/h up; the square is [-1, 1]^2). */
+inline const std::array<Eigen::Vector2d, 4> kFaceCorners{
+	Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1), Eigen::Vector2d(-1, -1)};
+
+/** Homography from normalised face coordinates to ideal pixels, from
+ * corners TL, TR, BR, BL (kFaceCorners' images). */
 Eigen::Matrix3d faceToImage(const Quad& corners_ideal);
+
+/** Maps normalised face coordinates to raw pixels (ideal ones when not
+ * \a distorted) through faceToImage()'s \a H. */
+struct FaceMap
+{
+	Eigen::Matrix3d H;
+	const CameraModel& cam;
+	bool distorted;
+
+	Eigen::Vector2d operator()(double x, double y) const
+	{
+		const Eigen::Vector3d q = H * Eigen::Vector3d(x, y, 1);
+		const Eigen::Vector2d ideal = q.head<2>() / q.z();
+		if (!distorted) return ideal;
+		return cam.distortNormalized(
+			{(ideal.x() - cam.cx()) / cam.fx(), (ideal.y() - cam.cy()) / cam.fy()});
+	}
+	Eigen::Vector2d operator()(const Eigen::Vector2d& f) const { return (*this)(f.x(), f.y()); }
+};
 
 /** Mean G at a raw pixel position (bilinear); nullopt outside the image. */
 std::optional<double> sampleG(const cv::Mat& bgr, double u, double v);

@@ -213,7 +213,7 @@ std::optional<double> locateRisingEdge(
 
 std::optional<double> correctLevelRounding(
 	const std::vector<int>& g_profiles, int n, const std::vector<int>& along,
-	const std::vector<double>& offset, int inward, std::vector<std::optional<double>>& edges)
+	const std::vector<int>& origin, int half, int inward, std::vector<std::optional<double>>& edges)
 {
 	constexpr int kMinSharp = 10;
 	constexpr double kMinSharpShare = 0.8;
@@ -222,6 +222,7 @@ std::optional<double> correctLevelRounding(
 	{
 		size_t j;
 		int m, v;
+		double f = 0;  //!< (v - L) / (H - L), once L and H are known
 	};
 	std::vector<Sharp> sharp;
 	int with_edge = 0, L = -1, H = -1;
@@ -254,12 +255,13 @@ std::optional<double> correctLevelRounding(
 	mean_s /= count;
 	Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
 	Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-	for (const auto& k : sharp)
+	for (auto& k : sharp)
 	{
-		const double f = (k.v - L) / A;
-		// The sharp edge's own estimate: the pixel's boundary less f.
-		const double c = offset[k.j] + inward * (k.m + 0.5 - f);
-		const Eigen::Vector3d phi(1, along[k.j] - mean_s, -inward * f / A);
+		k.f = (k.v - L) / A;
+		// The sharp edge's own estimate: the pixel's boundary less f, at
+		// across coordinate origin + inward (edge - half).
+		const double c = origin[k.j] + inward * (k.m + 0.5 - k.f - half);
+		const Eigen::Vector3d phi(1, along[k.j] - mean_s, -inward * k.f / A);
 		M += phi * phi.transpose();
 		rhs += phi * c;
 	}
@@ -267,11 +269,7 @@ std::optional<double> correctLevelRounding(
 	rhs *= 12 * A * A;
 	M(2, 2) += 6;
 	const double c_level = std::clamp(M.ldlt().solve(rhs)[2], -1.0, 1.0);
-	for (const auto& k : sharp)
-	{
-		const double f = (k.v - L) / A;
-		edges[k.j] = k.m + 0.5 - f + f * c_level / A;
-	}
+	for (const auto& k : sharp) edges[k.j] = k.m + 0.5 - k.f + k.f * c_level / A;
 	return c_level;
 }
 
@@ -313,9 +311,10 @@ std::optional<double> thinFrameOffset(
 	// pixel (a side slanting across the grid); one phase gives a sample a
 	// pixel, too few for the blur as well.
 	if (data.size() < (fixed_sigma > 0 ? 9u : 16u)) return std::nullopt;
-	// p: W, M, K, G, sigma, frame width, margin width, inner offset.
-	using Vec8 = Eigen::Matrix<double, 8, 1>;
-	using Mat8 = Eigen::Matrix<double, 8, 8>;
+	// p: W, M, K, G, sigma, margin width, inner offset; the frame width is
+	// frame_px.
+	using Vec7 = Eigen::Matrix<double, 7, 1>;
+	using Mat7 = Eigen::Matrix<double, 7, 7>;
 	const auto levelOver = [&](double lo, double hi, bool take_max, bool take_min)
 	{
 		double acc = 0, w = 0, best = take_max ? -1e9 : 1e9;
@@ -334,20 +333,18 @@ std::optional<double> thinFrameOffset(
 	const auto M0 = levelOver(-frame_px - 3, -frame_px + 0.5, true, false);
 	if (!K0 || !G0 || !M0) return std::nullopt;
 	const auto W0 = levelOver(x0, -frame_px - 3, false, false);
-	Vec8 q;
-	q << W0.value_or(*M0), *M0, *K0, *G0, fixed_sigma > 0 ? fixed_sigma : 0.8, frame_px, 1.0, 0.0;
-	const auto clampParams = [&](Vec8& t)
+	Vec7 q;
+	q << W0.value_or(*M0), *M0, *K0, *G0, fixed_sigma > 0 ? fixed_sigma : 0.8, 1.0, 0.0;
+	const auto clampParams = [&](Vec7& t)
 	{
-		t[4] = std::clamp(t[4], 0.2, 2.5);
-		t[5] = frame_px;
-		if (fixed_sigma > 0) t[4] = fixed_sigma;
+		t[4] = fixed_sigma > 0 ? fixed_sigma : std::clamp(t[4], 0.2, 2.5);
 		// The sheet's white above the frame's black, the fill above it too.
 		t[1] = std::max(t[1], t[2] + 10);
 		t[3] = std::max(t[3], t[2] + 10);
-		t[6] = std::clamp(t[6], 0.25 * frame_px, kBeyond);
-		t[7] = std::clamp(t[7], -1.0, 1.0);
+		t[5] = std::clamp(t[5], 0.25 * frame_px, kBeyond);
+		t[6] = std::clamp(t[6], -1.0, 1.0);
 	};
-	const auto residuals = [&](const Vec8& t, Mat8* JtJ, Vec8* Jtr)
+	const auto residuals = [&](const Vec7& t, Mat7* JtJ, Vec7* Jtr)
 	{
 		double cost = 0;
 		if (JtJ) JtJ->setZero();
@@ -355,45 +352,44 @@ std::optional<double> thinFrameOffset(
 		for (const Bin& d : data)
 		{
 			// The frame's and the margin's edges move with the inner one.
-			const double x = d.x - t[7];
-			const PixelStep s1 = pixelStep(x + t[5] + t[6], t[4]), s2 = pixelStep(x + t[5], t[4]),
-							s3 = pixelStep(x, t[4]);
+			const double x = d.x - t[6];
+			const PixelStep s1 = pixelStep(x + frame_px + t[5], t[4]),
+							s2 = pixelStep(x + frame_px, t[4]), s3 = pixelStep(x, t[4]);
 			const double W = t[0], M = t[1], K = t[2], G = t[3];
 			const double model = W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value;
 			const double r = model - d.v;
 			cost += d.w * r * r;
 			if (JtJ)
 			{
-				Vec8 J;
+				Vec7 J;
 				J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
 					fixed_sigma > 0
 						? 0.0
 						: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
-					0.0, (M - W) * s1.d_x,
-					-((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
+					(M - W) * s1.d_x, -((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
 				*JtJ += d.w * J * J.transpose();
 				*Jtr += d.w * r * J;
 			}
 		}
 		return cost;
 	};
-	Mat8 H;
-	Vec8 g;
+	Mat7 H;
+	Vec7 g;
 	double cost = residuals(q, &H, &g), mu = 1e-3;
 	bool converged = false;
 	for (int it = 0; it < 40 && !converged; ++it)
 	{
-		Mat8 A = H;
+		Mat7 A = H;
 		A.diagonal() += mu * H.diagonal().cwiseMax(1e-9);
-		Vec8 cand = q - A.ldlt().solve(g);
+		Vec7 cand = q - A.ldlt().solve(g);
 		if (!cand.allFinite()) return std::nullopt;
 		clampParams(cand);
-		Mat8 Hc;
-		Vec8 gc;
+		Mat7 Hc;
+		Vec7 gc;
 		const double cc = residuals(cand, &Hc, &gc);
 		if (cc < cost)
 		{
-			converged = std::abs(cand[7] - q[7]) < 1e-4 && cost - cc < 1e-8 * cost;
+			converged = std::abs(cand[6] - q[6]) < 1e-4 && cost - cc < 1e-8 * cost;
 			q = cand;
 			cost = cc;
 			H = Hc;
@@ -406,27 +402,25 @@ std::optional<double> thinFrameOffset(
 			converged = mu > 1e6;
 		}
 	}
-	if (std::abs(q[7]) > 0.5) return std::nullopt;
-	// The offset's standard error (the bins' residual variance, the frame
-	// width held), and the offset shrunk by it: d^2 / (d^2 + se^2) of it,
-	// so that sides whose profiles show no shift (a wide margin, a frame
-	// over 4 px) keep their edges rather than take the fit's noise.
-	// Held parameters (the frame's width, the blur if given) leave the
-	// inverse through unit diagonals.
-	Mat8 Hf = H;
-	for (const int k : {4, 5})
-		if (k == 5 || fixed_sigma > 0)
-		{
-			Hf.row(k).setZero();
-			Hf.col(k).setZero();
-			Hf(k, k) = 1;
-		}
+	if (std::abs(q[6]) > 0.5) return std::nullopt;
+	// The offset's standard error (the bins' residual variance), and the
+	// offset shrunk by it: d^2 / (d^2 + se^2) of it, so that sides whose
+	// profiles show no shift (a wide margin, a frame over 4 px) keep their
+	// edges rather than take the fit's noise. A held blur leaves the
+	// inverse through a unit diagonal.
+	Mat7 Hf = H;
+	if (fixed_sigma > 0)
+	{
+		Hf.row(4).setZero();
+		Hf.col(4).setZero();
+		Hf(4, 4) = 1;
+	}
 	const double dof = std::max(1.0, double(data.size()) - (fixed_sigma > 0 ? 6 : 7));
-	const double var = (cost / dof) * Hf.inverse()(7, 7);
+	const double var = (cost / dof) * Hf.inverse()(6, 6);
 	if (!(var >= 0)) return std::nullopt;
 	if (sigma_out) *sigma_out = q[4];
-	const double d2 = q[7] * q[7];
-	return q[7] * d2 / (d2 + var);
+	const double d2 = q[6] * q[6];
+	return q[6] * d2 / (d2 + var);
 }
 
 namespace
@@ -761,11 +755,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
 		// levels' rounding is one for all its edges.
 		if (p.correct_level_rounding && !clips && !all_clipped)
-		{
-			std::vector<double> offset(origin.size());
-			for (size_t j = 0; j < origin.size(); ++j) offset[j] = origin[j] - inward * half;
-			correctLevelRounding(g_prof, n, pos, offset, inward, edges);
-		}
+			correctLevelRounding(g_prof, n, pos, origin, half, inward, edges);
 		std::vector<Eigen::Vector2d> pts;
 		pts.reserve(pos.size());
 		for (size_t j = 0; j < pos.size(); ++j)
@@ -823,15 +813,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 		}
 		if (ok)
 		{
-			static const std::array<Eigen::Vector2d, 4> kFace{
-				Eigen::Vector2d(-1, 1), Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1),
-				Eigen::Vector2d(-1, -1)};
-			const Eigen::Matrix3d H = faceToImage(refined);
-			const auto toPixel = [&](const Eigen::Vector2d& f)
-			{
-				const Eigen::Vector3d q = H * Eigen::Vector3d(f.x(), f.y(), 1);
-				return Eigen::Vector2d(q.head<2>() / q.z());
-			};
+			// The lines, and so these corners, are in ideal pixels.
+			const FaceMap toPixel{faceToImage(refined), cam, false};
 			std::vector<double> sigmas;
 			std::array<double, 4> offsets{};
 			std::array<bool, 4> done{};
@@ -849,7 +832,8 @@ std::optional<RefinedQuad> refineQuadrangle(
 				{
 					if (!thin[side] || done[side]) continue;
 					const ThinSide& t = *thin[side];
-					const Eigen::Vector2d f0 = kFace[side], f1 = kFace[(side + 1) % 4];
+					const Eigen::Vector2d f0 = kFaceCorners[side],
+										  f1 = kFaceCorners[(side + 1) % 4];
 					const Eigen::Vector2d in = 0.5 * (f0 + f1),
 										  outer = in + frame_ratio * (f0 + f1);
 					const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
