@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 using namespace codemark;
 using namespace codemark::detect;
 
@@ -49,6 +53,43 @@ TEST(Options, InvalidValuesAreRejectedByName)
 	cfg2.write("D", "segmentation.hue_max_deg", 200);
 	EXPECT_THROW(o.loadFromConfigFile(cfg2, "D"), std::invalid_argument);
 	EXPECT_THROW(DetectorOptions::load("/nonexistent/detector.ini"), std::runtime_error);
+}
+
+// A value not of its key's type is refused with the key and the text
+// (MRPT's own readers take "maybe" for false and "3x" for 3).
+TEST(Options, ValuesOfTheWrongTypeAreRefused)
+{
+	for (const auto& [key, text] : std::vector<std::pair<std::string, std::string>>{
+			 {"subpixel.thin_frame_model", "maybe"},
+			 {"segmentation.step_px", "3x"},
+			 {"segmentation.step_px", "2.5"},
+			 {"subpixel.outlier_sigmas", "2.5 px"}})
+	{
+		mrpt::config::CConfigFileMemory cfg;
+		cfg.write("D", key, text);
+		DetectorOptions o;
+		try
+		{
+			o.loadFromConfigFile(cfg, "D");
+			ADD_FAILURE() << key << " = " << text << " was accepted";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(key + " = '" + text + "'"), std::string::npos)
+				<< e.what();
+		}
+	}
+	// Booleans in the spellings ini files use.
+	for (const auto& [text, value] : std::vector<std::pair<std::string, bool>>{
+			 {"true", true}, {"False", false}, {"1", true}, {"0", false}, {"yes", true}})
+	{
+		mrpt::config::CConfigFileMemory cfg;
+		cfg.write("D", "subpixel.thin_frame_model", text);
+		DetectorOptions o;
+		o.subpixel.thin_frame_model = !value;
+		o.loadFromConfigFile(cfg, "D");
+		EXPECT_EQ(o.subpixel.thin_frame_model, value) << text;
+	}
 }
 
 TEST(Options, ShippedIniHoldsTheDefaults)

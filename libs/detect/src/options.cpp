@@ -2,6 +2,7 @@
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -17,17 +18,39 @@ void require(bool ok, const char* name, const char* rule)
 		throw std::invalid_argument(std::string("detector option ") + name + " must be " + rule);
 }
 
-// Keys are "<block>.<field>", e.g. segmentation.step_px.
+// Keys are "<block>.<field>", e.g. segmentation.step_px. A value that is
+// not one of its type is refused with the key and the text: MRPT's
+// read_bool / read_int / read_double take "maybe" as false and "3x" as 3.
 template <typename T>
 void readKey(
 	const mrpt::config::CConfigFileBase& c, const std::string& s, const std::string& key, T& v)
 {
+	std::string text = c.read_string(s, key, "", false);
+	const auto first = text.find_first_not_of(" \t\r");
+	if (first == std::string::npos) return;	 // absent: the default stays
+	text = text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+	const auto refuse = [&](const char* what)
+	{ throw std::invalid_argument(key + " = '" + text + "' is not " + what); };
 	if constexpr (std::is_same_v<T, bool>)
-		v = c.read_bool(s, key, v);
-	else if constexpr (std::is_integral_v<T>)
-		v = c.read_int(s, key, v);
+	{
+		std::string t = text;
+		for (char& ch : t) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+		if (t == "true" || t == "1" || t == "yes")
+			v = true;
+		else if (t == "false" || t == "0" || t == "no")
+			v = false;
+		else
+			refuse("a boolean (true/false)");
+	}
 	else
-		v = c.read_double(s, key, v);
+	{
+		std::istringstream in(text);
+		T parsed{};
+		in >> parsed;
+		if (!in || !(in >> std::ws).eof())
+			refuse(std::is_integral_v<T> ? "an integer" : "a number");
+		v = parsed;
+	}
 }
 
 template <typename T>
