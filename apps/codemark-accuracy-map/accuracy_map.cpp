@@ -539,6 +539,7 @@ std::string writeResults(
 	  << (o.realistic ? "realistic scene (textured wall, light gradient, distractors)"
 					  : "plain background")
 	  << ", closed form " << (o.pose.refine_on_primary ? "refined on P" : "paper's formulas alone")
+	  << (o.pose.fold_ambiguity ? ", mirror-image solutions folded into C_L and C_R" : "")
 	  << ", each render aimed off the landmark by up to " << fmt(o.aim_jitter_rad, 2) << " rad and "
 	  << fmt(o.height_jitter_m, 2) << " m in height\n";
 	s << "# mean absolute errors averaged over the region's cells; cf = closed form, gen = general "

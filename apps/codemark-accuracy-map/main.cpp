@@ -71,6 +71,11 @@ int main(int argc, char** argv)
 			"The closed-form column uses the paper's formulas alone, without the weighted "
 			"least-squares refinement on P (PoseOptions::refine_on_primary, on by default).",
 			cmd, false);
+		TCLAP::SwitchArg fold_arg(
+			"", "fold-ambiguity",
+			"Both paths weigh the mirror-image solution against the kept one and fold it into "
+			"C_L and C_R (PoseOptions::fold_ambiguity, off by default).",
+			cmd, false);
 		TCLAP::SwitchArg realistic_arg(
 			"", "realistic",
 			"Render codemark's landmark in the realistic scene the C_P calibration was fitted "
@@ -125,6 +130,7 @@ int main(int argc, char** argv)
 		if (!detector_arg.getValue().empty())
 			o.detector = codemark::detect::DetectorOptions::load(detector_arg.getValue());
 		if (paper_arg.getValue()) o.pose.refine_on_primary = false;
+		if (fold_arg.getValue()) o.pose.fold_ambiguity = true;
 		o.realistic = realistic_arg.getValue();
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)

@@ -137,6 +137,13 @@ struct Runner
 				f.emplace_back("C_L", jsonMatrix(m.C_L));
 				f.emplace_back("pose_in_landmark", jsonVector(m.pose_in_landmark));
 				f.emplace_back("C_R", jsonMatrix(m.C_R));
+				// The mirror-image optimum folded into C_L and C_R (PoseOptions::
+				// fold_ambiguity), when there is one: its probability and L.
+				if (m.second_mode_weight > 0)
+				{
+					f.emplace_back("second_mode_weight", detect::jsonNumber(m.second_mode_weight));
+					f.emplace_back("second_mode_L", jsonVector(m.second_mode_L));
+				}
 			}
 			catch (const std::invalid_argument&)
 			{

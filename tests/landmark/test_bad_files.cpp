@@ -74,6 +74,25 @@ TEST(BadFiles, IniNumbersAcceptGoodValuesAndTrailingComments)
 	EXPECT_THROW(requireIniNumbers(cfg, "s", {"v"}), IniValueError);
 }
 
+// MRPT's read_bool() takes anything but true/false/yes/no/number as false,
+// and keeps a ';' comment in the value: "true ; note" reads false.
+TEST(BadFiles, IniBooleansAreRefusedUnlessReadAsWritten)
+{
+	const auto p = writeTemp(
+		"bools.ini",
+		"[s]\na = TRUE\nb = no // MRPT drops this comment\nc = 0\nd = maybe\ne = true ; note\n");
+	mrpt::config::CConfigFile cfg(p);
+	EXPECT_NO_THROW(requireIniBooleans(cfg, "s", {"a", "b", "c", "missing"}));
+	EXPECT_TRUE(cfg.read_bool("s", "a", false));
+	EXPECT_FALSE(cfg.read_bool("s", "b", true));
+	const std::string maybe = errorOf([&] { requireIniBooleans(cfg, "s", {"d"}, p); });
+	EXPECT_NE(maybe.find(p + ":5: [s] d = 'maybe': not a boolean"), std::string::npos) << maybe;
+	// The reason for refusing a commented boolean: MRPT would read it false.
+	EXPECT_FALSE(cfg.read_bool("s", "e", true));
+	const std::string note = errorOf([&] { requireIniBooleans(cfg, "s", {"e"}); });
+	EXPECT_NE(note.find("comment"), std::string::npos) << note;
+}
+
 TEST(BadFiles, CameraIniBadNumberMissingKeyNan)
 {
 	const std::string good = kCamera;

@@ -359,12 +359,30 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_DOUBLE_EQ(o.sigma_px, kDefaultSigmaPx);
 	o.method = PoseMethod::General6Dof;
 	o.sigma_px = 0.2;
+	o.fold_ambiguity = true;
 	mrpt::config::CConfigFileMemory cfg;
 	o.saveToConfigFile(cfg, "POSE");
 	PoseOptions r;
 	r.loadFromConfigFile(cfg, "POSE");
 	EXPECT_EQ(r.method, PoseMethod::General6Dof);
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
+	EXPECT_TRUE(r.fold_ambiguity);
+	// Not booleans (MRPT's read_bool would take them as false): named.
+	for (const char* key : {"fold_ambiguity", "refine_on_primary", "second_order_pose_covariance"})
+	{
+		mrpt::config::CConfigFileMemory bad;
+		o.saveToConfigFile(bad, "POSE");
+		bad.write("POSE", key, std::string("maybe"));
+		try
+		{
+			r.loadFromConfigFile(bad, "POSE");
+			ADD_FAILURE() << key << " = maybe was accepted";
+		}
+		catch (const std::exception& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+		}
+	}
 	cfg.write("POSE", "sigma_px", -1.0);
 	EXPECT_THROW(r.loadFromConfigFile(cfg, "POSE"), std::invalid_argument);
 	// Not numbers at all (MRPT would read 0.03 and 0): named, not taken.

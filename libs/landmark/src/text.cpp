@@ -164,4 +164,31 @@ void requireIniNumbers(
 	}
 }
 
+void requireIniBooleans(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+	std::initializer_list<const char*> keys, const std::string& file)
+{
+	for (const char* key : keys)
+	{
+		if (!cfg.keyExists(section, key)) continue;
+		const std::string raw = cfg.read_string(section, key, "");
+		// No comment stripped: read_bool() reads "true ; note" as false.
+		std::string v = trim(raw);
+		std::transform(
+			v.begin(), v.end(), v.begin(),
+			[](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+		if (v == "true" || v == "false" || v == "yes" || v == "no" || v == "1" || v == "0")
+			continue;
+		throw IniValueError(
+			section, key,
+			(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " +
+				key + " = '" + trim(raw) + "': not a boolean (true/false" +
+				(raw.find_first_of(";#") != std::string::npos
+					 ? "; MRPT reads a ';' or '#' comment after a boolean as part of it, and "
+					   "the whole as false"
+					 : "") +
+				")");
+	}
+}
+
 }  // namespace codemark

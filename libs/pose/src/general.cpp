@@ -46,6 +46,7 @@ Eigen::Matrix3d landmarkRModel()
 struct Projection
 {
 	double rms = 0;
+	Eigen::Matrix<double, 8, 1> r;	//!< projections minus the corners [px]
 	Eigen::Matrix<double, 8, 6> J;
 };
 
@@ -63,6 +64,8 @@ Projection project(
 	for (size_t i = 0; i < proj.size(); ++i)
 	{
 		const cv::Point2d d = proj[i] - img[i];
+		out.r[2 * i] = d.x;
+		out.r[2 * i + 1] = d.y;
 		ss += d.x * d.x + d.y * d.y;
 	}
 	out.rms = std::sqrt(ss / (2.0 * proj.size()));
@@ -224,6 +227,10 @@ GeneralPose solveGeneralPose(
 		}
 	}
 
+	// A singular corner covariance (exact corners) leaves the solutions
+	// unweighed (chi2 and log_det_cov 0).
+	const Eigen::LLT<CornerCovariance> Cc_llt(corner_cov);
+	const bool weighable = Cc_llt.info() == Eigen::Success;
 	std::vector<PnPSolution> sols;
 	for (const Vec6& p : candidates)
 	{
@@ -240,6 +247,14 @@ GeneralPose solveGeneralPose(
 		// (J^T J)^-1 J^T C_c J (J^T J)^-1.
 		const Eigen::Matrix<double, 6, 6> JtJi = (pr.J.transpose() * pr.J).inverse();
 		s.cov = JtJi * pr.J.transpose() * corner_cov * pr.J * JtJi;
+		// The corners' Mahalanobis residual and the width of the weighted
+		// optimum (Laplace), which weigh this solution against the other
+		// (foldModes()).
+		if (weighable)
+		{
+			s.chi2 = pr.r.dot(Cc_llt.solve(pr.r));
+			s.log_det_cov = -std::log((pr.J.transpose() * Cc_llt.solve(pr.J)).determinant());
+		}
 		// Only the landmark's front side is printed: a camera behind it is no solution.
 		if (s.landmark_T_camera.x() > 0) sols.push_back(s);
 	}
@@ -256,26 +271,33 @@ GeneralPose solveGeneralPose(
 							  ? std::numeric_limits<double>::infinity()
 							  : sols[1].rms_px / sols[0].rms_px;
 
-	// Reduction to (L, pose_in_landmark) with its Jacobian by central
-	// differences; angle differences wrapped.
-	const Vec6& p0 = sols[0].rvec_tvec;
-	const Vec6 v0 = reduce(p0);
-	Eigen::Matrix<double, 6, 6> Jr;
-	for (int k = 0; k < 6; ++k)
+	// Reduction of each solution to (L, pose_in_landmark) with its Jacobian
+	// by central differences; angle differences wrapped.
+	for (PnPSolution& s : out.solutions)
 	{
-		const double step = k < 3 ? 1e-6 : 1e-6 * std::max(1e-3, p0.tail<3>().norm());
-		Vec6 a = p0, b = p0;
-		a[k] += step;
-		b[k] -= step;
-		Vec6 d = reduce(a) - reduce(b);
-		for (const int ang : {1, 2, 5}) d[ang] = wrapToPi(d[ang]);
-		Jr.col(k) = d / (2 * step);
+		const Vec6& p0 = s.rvec_tvec;
+		const Vec6 v0 = reduce(p0);
+		Eigen::Matrix<double, 6, 6> Jr;
+		for (int k = 0; k < 6; ++k)
+		{
+			const double step = k < 3 ? 1e-6 : 1e-6 * std::max(1e-3, p0.tail<3>().norm());
+			Vec6 a = p0, b = p0;
+			a[k] += step;
+			b[k] -= step;
+			Vec6 d = reduce(a) - reduce(b);
+			for (const int ang : {1, 2, 5}) d[ang] = wrapToPi(d[ang]);
+			Jr.col(k) = d / (2 * step);
+		}
+		const Eigen::Matrix<double, 6, 6> C = Jr * s.cov * Jr.transpose();
+		s.L = v0.head<3>();
+		s.pose_in_landmark = v0.tail<3>();
+		s.C_L = C.topLeftCorner<3, 3>();
+		s.C_R = C.bottomRightCorner<3, 3>();
 	}
-	const Eigen::Matrix<double, 6, 6> C = Jr * sols[0].cov * Jr.transpose();
-	out.L = v0.head<3>();
-	out.pose_in_landmark = v0.tail<3>();
-	out.C_L = C.topLeftCorner<3, 3>();
-	out.C_R = C.bottomRightCorner<3, 3>();
+	out.L = out.solutions[0].L;
+	out.pose_in_landmark = out.solutions[0].pose_in_landmark;
+	out.C_L = out.solutions[0].C_L;
+	out.C_R = out.solutions[0].C_R;
 	return out;
 }
 

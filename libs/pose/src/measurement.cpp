@@ -1,6 +1,8 @@
 #include <codemark/landmark/primary.h>
 #include <codemark/landmark/text.h>
+#include <codemark/landmark/truth.h>
 #include <codemark/pose/closed_form.h>
+#include <codemark/pose/ambiguity.h>
 #include <codemark/pose/general.h>
 #include <codemark/pose/measurement.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -142,6 +144,8 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 		 "corr_growth_y12", "clipped_side_sigma_px", "clipped_side_correlation",
 		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio", "min_sigma_px"});
 	requireIniNumbers(c, s, {"lm_max_iterations"}, true);
+	requireIniBooleans(
+		c, s, {"second_order_pose_covariance", "refine_on_primary", "fold_ambiguity"});
 	method = poseMethodFromString(c.read_string(s, "method", toString(method)));
 	MRPT_LOAD_CONFIG_VAR(sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(sigma_y_px, double, c, s);
@@ -166,6 +170,7 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(corner_tilt_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(second_order_pose_covariance, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(refine_on_primary, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(fold_ambiguity, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lm_max_iterations, int, c, s);
 	validate();
@@ -228,6 +233,9 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(
 		s, "refine_on_primary", refine_on_primary, -1, -1,
 		"closed form: refine L by weighted least squares on P with C_P");
+	c.write(
+		s, "fold_ambiguity", fold_ambiguity, -1, -1,
+		"weigh the mirror-image solution and fold it into C_L, C_R");
 	c.write(
 		s, "min_sigma_px", min_sigma_px, -1, -1,
 		"Detector: floor of the sigma of a component of P [px]");
@@ -317,20 +325,70 @@ Measurement measureWith(
 		m.C_P += options.alignedEdgesCovariance(
 			m.P, ideal[1].y() - ideal[0].y(), ideal[2].y() - ideal[3].y());
 	}
+	const auto poseCovariance = [&](const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L,
+									const Eigen::Matrix3d& first_order) {
+		return options.second_order_pose_covariance ? poseCovarianceSecondOrder(L, C_L)
+													: first_order;
+	};
+	const auto fold = [&](const MeasurementMode& a, const MeasurementMode& b)
+	{
+		// Optima closer than a tenth of the local sigma of phi2 are one
+		// (both starts reached the same valley floor).
+		const double dphi2 = std::abs(wrapToPi(b.L[2] - a.L[2]));
+		if (!(dphi2 > 0.1 * std::sqrt(std::min(a.C_L(2, 2), b.C_L(2, 2))))) return;
+		MeasurementMode other;
+		const MeasurementMode k = foldModes(a, b, &m.second_mode_weight, &other);
+		m.second_mode_L = other.L;
+		m.L = k.L;
+		m.C_L = k.C_L;
+		m.pose_in_landmark = k.pose_in_landmark;
+		m.C_R = k.C_R;
+	};
 	if (options.method == PoseMethod::ClosedForm)
 	{
 		Eigen::Matrix<double, 3, 4> J_P;
 		Eigen::Matrix3d J_L;
 		const bool refine = options.refine_on_primary;
-		m.L = landmarkFromPrimary(m.P, lambda, geometry.innerHalf(), refine ? nullptr : &J_P);
+		const double h = geometry.innerHalf();
+		m.L = landmarkFromPrimary(m.P, lambda, h, refine ? nullptr : &J_P);
 		if (refine)
-			m.L = refineLandmarkOnPrimary(m.P, m.C_P, lambda, geometry.innerHalf(), m.L, &m.C_L);
+			m.L = refineLandmarkOnPrimary(m.P, m.C_P, lambda, h, m.L, &m.C_L);
 		else
 			m.C_L = J_P * m.C_P * J_P.transpose();
 		m.pose_in_landmark = poseFromLandmark(m.L, &J_L);
-		m.C_R = options.second_order_pose_covariance
-					? poseCovarianceSecondOrder(m.L, m.C_L)
-					: Eigen::Matrix3d(J_L * m.C_L * J_L.transpose());
+		m.C_R = poseCovariance(m.L, m.C_L, J_L * m.C_L * J_L.transpose());
+		if (refine && options.fold_ambiguity)
+		{
+			const auto closedFormMode = [&](const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L)
+			{
+				MeasurementMode mode;
+				mode.L = L;
+				mode.C_L = C_L;
+				Eigen::Matrix3d J;
+				mode.pose_in_landmark = poseFromLandmark(L, &J);
+				mode.C_R = poseCovariance(L, C_L, J * C_L * J.transpose());
+				const Eigen::Vector4d r = m.P - primaryFromLandmark(L, lambda, h);
+				mode.chi2 = r.dot(m.C_P.ldlt().solve(r));
+				mode.log_det_cov = std::log(C_L.determinant());
+				return mode;
+			};
+			// The mirror image about the line of sight: view angle phi1 + phi2
+			// -> -(phi1 + phi2), refined in its own right.
+			Eigen::Vector3d L0 = m.L;
+			L0[2] = wrapToPi(-2 * m.L[1] - m.L[2]);
+			Eigen::Matrix3d C_mirror;
+			try
+			{
+				const Eigen::Vector3d L_mirror =
+					refineLandmarkOnPrimary(m.P, m.C_P, lambda, h, L0, &C_mirror);
+				if (C_mirror.allFinite() && C_mirror.determinant() > 0)
+					fold(closedFormMode(m.L, m.C_L), closedFormMode(L_mirror, C_mirror));
+			}
+			catch (const std::invalid_argument&)
+			{
+				// The mirror start put an edge behind the camera: no second optimum.
+			}
+		}
 		return m;
 	}
 	// The general path takes the corner covariance whose image in P is C_P
@@ -346,15 +404,39 @@ Measurement measureWith(
 		cornerCovarianceFromPrimary(
 			corners, camera, m.C_P, options.corner_midpoint_ratio, options.corner_tilt_ratio),
 		options.lm_max_iterations);
-	m.L = g.L;
-	m.C_L = g.C_L;
-	m.pose_in_landmark = g.pose_in_landmark;
 	// The planar pose is poseFromLandmark(L) on this path too: the same
 	// curvature beyond 2 m (poseCovarianceSecondOrder()).
-	m.C_R = options.second_order_pose_covariance ? poseCovarianceSecondOrder(m.L, m.C_L) : g.C_R;
+	const auto generalMode = [&](const PnPSolution& s)
+	{
+		MeasurementMode mode;
+		mode.L = s.L;
+		mode.C_L = s.C_L;
+		mode.pose_in_landmark = s.pose_in_landmark;
+		mode.C_R = poseCovariance(s.L, s.C_L, s.C_R);
+		mode.chi2 = s.chi2;
+		mode.log_det_cov = s.log_det_cov;
+		return mode;
+	};
+	const MeasurementMode best = generalMode(g.solutions[0]);
+	m.L = best.L;
+	m.C_L = best.C_L;
+	m.pose_in_landmark = best.pose_in_landmark;
+	m.C_R = best.C_R;
 	m.landmark_T_camera = g.solutions[0].landmark_T_camera;
 	m.reprojection_rms_px = g.solutions[0].rms_px;
 	m.ambiguity_ratio = g.ambiguity_ratio;
+	if (options.fold_ambiguity && g.solutions.size() > 1 &&
+		std::isfinite(g.solutions[1].log_det_cov) && std::isfinite(best.log_det_cov))
+	{
+		const MeasurementMode second = generalMode(g.solutions[1]);
+		fold(best, second);
+		if (m.second_mode_weight > 0 && secondModeWeight(best, second) > 0.5)
+		{
+			// The second solution is the more probable one: its 6-DoF pose.
+			m.landmark_T_camera = g.solutions[1].landmark_T_camera;
+			m.reprojection_rms_px = g.solutions[1].rms_px;
+		}
+	}
 	return m;
 }
 }  // namespace

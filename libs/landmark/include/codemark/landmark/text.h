@@ -47,6 +47,17 @@ void requireIniNumbers(
 	std::initializer_list<const char*> keys, bool integers = false, bool vector = false,
 	const std::string& file = {});
 
+/** Checks that each of \a keys that [\a section] of \a cfg sets holds a
+ * boolean as MRPT's read_bool() reads it: true, false, yes, no, 1 or 0
+ * (any case). read_bool() takes anything else as false without a word:
+ * "maybe", "on", and "true ; note" too (it keeps a ';' or '#' comment in
+ * the value, unlike a '//' one). Throws
+ * IniValueError "[SECTION] KEY = 'VALUE': not a boolean (true/false)",
+ * prefixed with "FILE:LINE: " when \a file is given. */
+void requireIniBooleans(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+	std::initializer_list<const char*> keys, const std::string& file = {});
+
 /** "FILE:LINE: " of \a key in [\a section] of the ini file \a file, or
  * "FILE: " when the key is not found there. */
 std::string iniWhere(const std::string& file, const std::string& section, const std::string& key);

@@ -38,6 +38,16 @@ struct PnPSolution
 	 * covariance; sigma^2 (J^T J)^-1 for isotropic noise), J the 8x6
 	 * Jacobian of the raw-pixel projections (cv::projectPoints). */
 	Eigen::Matrix<double, 6, 6> cov = Eigen::Matrix<double, 6, 6>::Zero();
+	/** The corners' squared Mahalanobis residual r^T C_c^-1 r at this
+	 * solution. */
+	double chi2 = 0;
+	/** log det (J^T C_c^-1 J)^-1: the width of this solution in Laplace's
+	 * approximation of its probability mass (pose::foldModes()). */
+	double log_det_cov = 0;
+	Eigen::Vector3d L = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] of this solution
+	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< first order, from cov
+	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();	 //!< (x, y, theta) in L
+	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();	//!< first order, from cov
 };
 
 /** Result of the general path. */
@@ -48,7 +58,9 @@ struct GeneralPose
 	/** solutions[1].rms / solutions[0].rms (infinity when solutions[0] is
 	 * exact or alone): the ambiguity of the planar pose, large = clear. */
 	double ambiguity_ratio = 0;
-	Eigen::Vector3d L = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] of the best solution
+	/** [l2 phi1 phi2] of the best solution and its local covariance (the
+	 * other solution is not folded in here: pose::measure() does that). */
+	Eigen::Vector3d L = Eigen::Vector3d::Zero();
 	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();
 	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();	 //!< (x, y, theta) in L
 	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();

@@ -206,6 +206,16 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * at 3-5 m, docs/benchmarks/pose.md), C_L from the Fisher information.
 	 * Still P alone. ini key `refine_on_primary`. */
 	bool refine_on_primary = true;
+	/** Weigh the measurement's second local optimum, the landmark's mirror
+	 * image about the line of sight (view angle phi1 + phi2 -> -(phi1 +
+	 * phi2), IPPE's second solution on the general path), against the first
+	 * and report the more probable one with the mean squared error over both
+	 * as C_L and C_R (foldModes(), ambiguity.h). Far and near-frontal the
+	 * two fit the corners almost equally, and the local covariance alone
+	 * put phi2 within 1.5 deg of a truth 12 deg away (docs/benchmarks/pose.md).
+	 * Closed form refined on P (refine_on_primary) and general path. ini key
+	 * `fold_ambiguity`. */
+	bool fold_ambiguity = false;
 	/** General path: Levenberg-Marquardt iterations of each refinement. */
 	int lm_max_iterations = 30;
 
@@ -242,6 +252,12 @@ struct Measurement
 	 * over that of the chosen one (>= 1; large = unambiguous; infinity when
 	 * the chosen one is exact or there is one solution). */
 	double ambiguity_ratio = 0;
+	/** With PoseOptions::fold_ambiguity: the probability of the second
+	 * local optimum (the mirror image about the line of sight), folded into
+	 * C_L and C_R; 0 when there is none or folding is off. */
+	double second_mode_weight = 0;
+	/** That optimum's L when second_mode_weight > 0. */
+	Eigen::Vector3d second_mode_L = Eigen::Vector3d::Zero();
 };
 
 /** Measures one landmark from its four reference points.

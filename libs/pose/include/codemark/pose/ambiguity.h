@@ -1,0 +1,57 @@
+#pragma once
+/** \file ambiguity.h
+ * The two-fold ambiguity of a small planar landmark, folded into the
+ * reported covariance.
+ *
+ * Far and near-frontal, the corners hardly tell the landmark's orientation
+ * phi2 from its mirror image about the line of sight (view angle
+ * phi1 + phi2 -> -(phi1 + phi2)): both fit the corners, and a bias of a
+ * few hundredths of a pixel decides which is the least-squares optimum (the
+ * planar-pose ambiguity that IPPE returns as two solutions). The local,
+ * first-order covariance of the chosen mode knows nothing of the other: on
+ * the accuracy map at 4.5 m seen nearly squarely it reported phi2 within
+ * 1.5 deg of a truth 12 deg away (NEES in the thousands,
+ * docs/benchmarks/pose.md). Here the two modes are weighed by Laplace's
+ * approximation of their probability mass, and the reported covariance is
+ * the mean squared error about the more probable mode over both: the
+ * smallest covariance that stays honest whichever mode is true.
+ */
+#include <Eigen/Core>
+
+namespace codemark::pose
+{
+/** One local optimum of a sighting's likelihood, with its Gaussian (local)
+ * approximation. */
+struct MeasurementMode
+{
+	Eigen::Vector3d L = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] at the mode
+	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< its local covariance
+	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();	 //!< (x, y, theta) in L
+	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();	//!< its local covariance
+	/** The data's squared Mahalanobis residual at the mode (P's against C_P
+	 * on the closed form, the corners' against their covariance on the
+	 * general path). */
+	double chi2 = 0;
+	/** log det of the covariance of the parameters solved for at the mode
+	 * (L on the closed form, the 6-DoF pose on the general path): the
+	 * width of the mode in Laplace's approximation of its mass. */
+	double log_det_cov = 0;
+};
+
+/** The posterior probability of mode \a b when the data has modes \a a and
+ * \a b only (flat prior; Laplace's approximation of each mode's mass,
+ * exp(-chi2 / 2) sqrt(det cov)). 0.5 for two equal modes. */
+double secondModeWeight(const MeasurementMode& a, const MeasurementMode& b);
+
+/** \a a and \a b folded into one mode: the more probable one's L and pose,
+ * each covariance the mean squared error about them over the two-mode
+ * mixture, (1 - w) C_kept + w (C_other + d d^T), w the other mode's
+ * probability (secondModeWeight()) and d the difference of the means
+ * (angles wrapped). \a other_weight, if not null, receives w (<= 0.5);
+ * \a other, if not null, the mode not kept. chi2 and log_det_cov are
+ * the kept mode's. */
+MeasurementMode foldModes(
+	const MeasurementMode& a, const MeasurementMode& b, double* other_weight = nullptr,
+	MeasurementMode* other = nullptr);
+
+}  // namespace codemark::pose

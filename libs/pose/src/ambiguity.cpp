@@ -1,0 +1,37 @@
+#include <codemark/landmark/truth.h>
+#include <codemark/pose/ambiguity.h>
+
+#include <cmath>
+
+namespace codemark::pose
+{
+double secondModeWeight(const MeasurementMode& a, const MeasurementMode& b)
+{
+	// log(mass_a / mass_b) = -(chi2_a - chi2_b) / 2 + (logdet_a - logdet_b) / 2.
+	const double log_ratio = 0.5 * ((b.chi2 - a.chi2) + (a.log_det_cov - b.log_det_cov));
+	if (!std::isfinite(log_ratio)) return log_ratio > 0 || std::isnan(log_ratio) ? 0.0 : 1.0;
+	return 1.0 / (1.0 + std::exp(log_ratio));
+}
+
+MeasurementMode foldModes(
+	const MeasurementMode& a, const MeasurementMode& b, double* other_weight,
+	MeasurementMode* other)
+{
+	const double wb = secondModeWeight(a, b);
+	const bool keep_a = wb <= 0.5;
+	const MeasurementMode& k = keep_a ? a : b;
+	const MeasurementMode& o = keep_a ? b : a;
+	const double w = keep_a ? wb : 1 - wb;
+	Eigen::Vector3d dL = o.L - k.L, dR = o.pose_in_landmark - k.pose_in_landmark;
+	dL[1] = wrapToPi(dL[1]);
+	dL[2] = wrapToPi(dL[2]);
+	dR[2] = wrapToPi(dR[2]);
+	MeasurementMode out = k;
+	out.C_L = (1 - w) * k.C_L + w * (o.C_L + dL * dL.transpose());
+	out.C_R = (1 - w) * k.C_R + w * (o.C_R + dR * dR.transpose());
+	if (other_weight) *other_weight = w;
+	if (other) *other = o;
+	return out;
+}
+
+}  // namespace codemark::pose
