@@ -31,7 +31,7 @@ if [[ $quick -eq 1 ]]; then
   exit 0
 fi
 echo "== C_P calibration (realistic scenes, the shipped values: clipped and unclipped sides averaged)"
-"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance --averaged
+"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 60 --uniform-distance --averaged
 echo "== C_P calibration (realistic scenes, clipped sides apart)"
 "$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance
 echo "== C_P calibration (the accuracy map's flat background: its C_P, plainBackgroundPoseOptions)"

@@ -36,14 +36,6 @@ MeasurementMode modeAt(double phi2, double chi2, double sigma_phi2)
 	return m;
 }
 
-// 95% band of the mean of n chi-square(3) variables (Wilson-Hilferty).
-std::pair<double, double> neesBand(int n)
-{
-	const double k = 3.0 * n, h = 2.0 / (9 * k), z = 1.959963984540054;
-	return {
-		k * std::pow(1 - h - z * std::sqrt(h), 3) / n,
-		k * std::pow(1 - h + z * std::sqrt(h), 3) / n};
-}
 }  // namespace
 
 TEST(Ambiguity, FoldModesWeighsByMassAndCoversTheOtherMode)

@@ -182,12 +182,11 @@ struct SubpixelParams
 	 * (detect::thinFrameOffset()). The peak model knows the frame's outer
 	 * edge but not the margin's: where the spec's 5 mm margin is under a
 	 * pixel, the wall's edge to it cancels part of the frame's lobe, and
-	 * the edges lie 0.05-0.1 px inwards. Off by default until C_P is
-	 * calibrated for it: on the accuracy map it takes the position error
-	 * from 2 to 5 m from 30.2 to 21.8 mm, which leaves the shipped C_P
-	 * conservative (the simulated loops' EKF NEES 2.49, under its band;
-	 * docs/benchmarks/pose.md). */
-	bool thin_frame_model = false;
+	 * the edges lie 0.05-0.1 px inwards. On the accuracy map it takes the
+	 * position error from 2 to 5 m from 30.2 to 21.8 mm, and codemark is
+	 * then no worse than AprilTag 3 in any cell; the shipped C_P is
+	 * calibrated with it (pipeline.h, docs/benchmarks/pose.md). */
+	bool thin_frame_model = true;
 	/** Refine the derivative's peak with the exact response of a
 	 * pixel-integrated Gaussian step (its position, blur and height from
 	 * the three samples) instead of the log-parabola's Gaussian, which
