@@ -82,7 +82,7 @@ constexpr double kDetectorSizeExponentY = 1.25;	 //!< exponent of the y growth
 constexpr double kDetectorCorrX12 = 0.05;  //!< corr(x1, x2), constant part
 constexpr double kDetectorCorrGrowthX12 = -0.40;  //!< corr(x1, x2), growing part
 constexpr double kDetectorCorrY12 = 0.40;  //!< corr(y1, y2), constant part
-constexpr double kDetectorCorrGrowthY12 = -0.15;	 //!< corr(y1, y2), growing part
+constexpr double kDetectorCorrGrowthY12 = -0.15;  //!< corr(y1, y2), growing part
 /** The corners' other four numbers (general path,
  * pose::cornerCovarianceFromPrimary(); the same fit): an edge's midpoint
  * height errs 0.78 sigma(y_i), its tilt 0.24 sigma(x_i): the detector's
