@@ -250,12 +250,8 @@ std::vector<CellResult> runSurvey(
 {
 	if (!(o.cell_m > 0) || o.renders_per_cell < 1)
 		throw std::invalid_argument("survey: cell_m must be > 0 and renders_per_cell >= 1");
-	sim::Scene scene;
-	MapLandmark lm;
-	lm.id = 37;
-	lm.z_m = 0.5;
-	scene.map.landmarks.push_back(lm);
-	scene.camera = camera;
+	sim::Scene scene = sim::singleLandmarkScene(camera);
+	const MapLandmark& lm = scene.map.landmarks[0];
 	sim::RenderOptions ro =
 		o.realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
 	ro.noise_sigma = o.noise_sigma;

@@ -128,12 +128,8 @@ int main(int argc, char** argv)
 				"expected --renders >= 1, 0 < --min-distance < --max-distance, --max-angle in "
 				"[0, 90), --max-bearing and --max-height >= 0, --level-fraction in [0, 1]");
 
-		sim::Scene scene;
-		MapLandmark lm;
-		lm.id = 37;
-		lm.z_m = 0.5;
-		scene.map.landmarks.push_back(lm);
-		scene.camera = CameraModel::paperDefault();
+		sim::Scene scene = sim::singleLandmarkScene();
+		const MapLandmark& lm = scene.map.landmarks[0];
 		sim::RenderOptions ro;
 		ro.noise_sigma = 2;
 		ro.blur_sigma_px = 0.8;

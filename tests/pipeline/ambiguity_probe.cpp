@@ -30,12 +30,8 @@ int main(int argc, char** argv)
 	const double ang = (argc > 2 ? atof(argv[2]) : 6.34) * M_PI / 180;
 	const int renders = argc > 3 ? atoi(argv[3]) : 80;
 	const int realistic = argc > 4 ? atoi(argv[4]) : 0;
-	sim::Scene scene;
-	MapLandmark lm;
-	lm.id = 37;
-	lm.z_m = 0.5;
-	scene.map.landmarks.push_back(lm);
-	scene.camera = CameraModel::paperDefault();
+	sim::Scene scene = sim::singleLandmarkScene();
+	const MapLandmark& lm = scene.map.landmarks[0];
 	sim::RenderOptions ro =
 		realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
 	ro.noise_sigma = 2;

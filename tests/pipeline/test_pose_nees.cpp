@@ -53,12 +53,8 @@ const NeesResult& neesOnRenders()
 	static const NeesResult result = []
 	{
 		NeesResult out;
-		sim::Scene scene;
-		MapLandmark lm;
-		lm.id = 37;
-		lm.z_m = 0.5;
-		scene.map.landmarks.push_back(lm);
-		scene.camera = CameraModel::paperDefault();
+		sim::Scene scene = sim::singleLandmarkScene();
+		const MapLandmark& lm = scene.map.landmarks[0];
 		// The calibration's conditions: textured wall, light gradient, noise 2,
 		// blur 0.8 px.
 		const sim::RenderOptions ro = sim::DatasetOptions::realisticRender();
@@ -154,12 +150,8 @@ TEST(PoseNees, ClosedFormIsConsistentOnRenders) { checkNees(0); }
 // 1e-6 is tests/pose/test_sim.cpp.
 TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 {
-	sim::Scene scene;
-	MapLandmark lm;
-	lm.id = 37;
-	lm.z_m = 0.5;
-	scene.map.landmarks.push_back(lm);
-	scene.camera = CameraModel::paperDefault();
+	sim::Scene scene = sim::singleLandmarkScene();
+	const MapLandmark& lm = scene.map.landmarks[0];
 	const LandmarkGeometry g = lm.geometry();
 	int n = 0;
 	std::array<double, 5> worst{};

@@ -510,6 +510,17 @@ Render render(const Scene& scene, const RenderOptions& o, uint64_t seed)
 	return out;
 }
 
+Scene singleLandmarkScene(const CameraModel& camera, int id, double z_m)
+{
+	Scene scene;
+	MapLandmark lm;
+	lm.id = id;
+	lm.z_m = z_m;
+	scene.map.landmarks.push_back(lm);
+	scene.camera = camera;
+	return scene;
+}
+
 mrpt::poses::CPose3D levelCameraLookingAt(
 	const MapLandmark& landmark, double distance_m, double view_angle_rad, double height_m,
 	double bearing_rad)

@@ -150,6 +150,13 @@ const char* backgroundName(Background b);
  * std::invalid_argument otherwise. */
 Background backgroundFromName(const std::string& name);
 
+/** A scene of one landmark (ID \a id, the spec's size, its centre \a z_m
+ * above the floor at the world's origin) seen by \a camera: the setup of
+ * the pose calibration, the accuracy map and their tests. Place the camera
+ * with levelCameraLookingAt(scene.map.landmarks[0], ...). */
+Scene singleLandmarkScene(
+	const CameraModel& camera = CameraModel::paperDefault(), int id = 37, double z_m = 0.5);
+
 /** A level camera (optical axis horizontal, no roll) at horizontal distance
  * \a distance_m [m] from \a landmark's centre, seen at \a view_angle_rad between
  * the line of sight and the landmark's outward normal (counter-clockwise
