@@ -1,4 +1,5 @@
 #include <codemark/detect/options.h>
+#include <codemark/landmark/text.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -33,14 +34,9 @@ void readKey(
 	{ throw std::invalid_argument(key + " = '" + text + "' is not " + what); };
 	if constexpr (std::is_same_v<T, bool>)
 	{
-		std::string t = text;
-		for (char& ch : t) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-		if (t == "true" || t == "1" || t == "yes")
-			v = true;
-		else if (t == "false" || t == "0" || t == "no")
-			v = false;
-		else
-			refuse("a boolean (true/false)");
+		const auto b = parseIniBoolean(text);
+		if (!b) refuse("a boolean (true/false)");
+		v = *b;
 	}
 	else
 	{

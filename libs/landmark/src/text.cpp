@@ -133,6 +133,32 @@ void rethrowNamingIniFile(const std::string& file)
 	}
 }
 
+std::optional<bool> parseIniBoolean(const std::string& text)
+{
+	std::string v = trim(text);
+	std::transform(
+		v.begin(), v.end(), v.begin(),
+		[](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+	if (v == "true" || v == "yes" || v == "1") return true;
+	if (v == "false" || v == "no" || v == "0") return false;
+	return std::nullopt;
+}
+
+namespace
+{
+// "FILE:LINE: [SECTION] KEY = 'VALUE': WHAT" (no "FILE:LINE: " without a
+// file), the refusal of requireIniNumbers() and requireIniBooleans().
+IniValueError iniValueError(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
+	const std::string& file, const std::string& what)
+{
+	return IniValueError(
+		section, key,
+		(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " + key +
+			" = '" + trim(cfg.read_string(section, key, "")) + "': " + what);
+}
+}  // namespace
+
 void requireIniNumbers(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section,
 	std::initializer_list<const char*> keys, bool integers, bool vector, const std::string& file)
@@ -156,11 +182,10 @@ void requireIniNumbers(
 			ok = x && (!integers || std::floor(*x) == *x);
 		}
 		if (ok && (count == 1 || (vector && count > 0))) continue;
-		throw IniValueError(
-			section, key,
-			(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " +
-				key + " = '" + trim(raw) + "': not " + (vector ? "a list of " : "a ") +
-				(integers ? "whole" : "finite") + (vector ? " numbers" : " number"));
+		throw iniValueError(
+			cfg, section, key, file,
+			std::string("not ") + (vector ? "a list of " : "a ") + (integers ? "whole" : "finite") +
+				(vector ? " numbers" : " number"));
 	}
 }
 
@@ -171,18 +196,12 @@ void requireIniBooleans(
 	for (const char* key : keys)
 	{
 		if (!cfg.keyExists(section, key)) continue;
-		const std::string raw = cfg.read_string(section, key, "");
 		// No comment stripped: read_bool() reads "true ; note" as false.
-		std::string v = trim(raw);
-		std::transform(
-			v.begin(), v.end(), v.begin(),
-			[](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-		if (v == "true" || v == "false" || v == "yes" || v == "no" || v == "1" || v == "0")
-			continue;
-		throw IniValueError(
-			section, key,
-			(file.empty() ? std::string() : iniWhere(file, section, key)) + "[" + section + "] " +
-				key + " = '" + trim(raw) + "': not a boolean (true/false" +
+		const std::string raw = cfg.read_string(section, key, "");
+		if (parseIniBoolean(raw)) continue;
+		throw iniValueError(
+			cfg, section, key, file,
+			std::string("not a boolean (true/false") +
 				(raw.find_first_of(";#") != std::string::npos
 					 ? "; MRPT reads a ';' or '#' comment after a boolean as part of it, and "
 					   "the whole as false"

@@ -17,6 +17,11 @@ namespace codemark
  * "1.5x", "nan", "inf" or ""), else nullopt. */
 std::optional<double> parseFiniteNumber(const std::string& token);
 
+/** \a text as MRPT's read_bool() reads it when it is one of true, false,
+ * yes, no, 1 or 0 (any case, surrounding blanks ignored), else nullopt:
+ * read_bool() takes anything else as false without a word. */
+std::optional<bool> parseIniBoolean(const std::string& text);
+
 /** The numbers of one line of a table, everything from the first of
  * \a comment_chars on dropped; empty for a blank or comment line. Throws
  * std::runtime_error "FILE:LINE: 'TOKEN' is not a finite number". */
