@@ -118,6 +118,30 @@ mrpt::poses::CPose3D landmarkTCameraFromRvecTvec(const Eigen::Matrix<double, 6, 
 	return mrpt::poses::CPose3D(mrpt::math::CMatrixDouble44(T));
 }
 
+void reducePnPSolution(PnPSolution& s)
+{
+	// Jacobian of the reduction by central differences; angle differences
+	// wrapped.
+	const Vec6& p0 = s.rvec_tvec;
+	const Vec6 v0 = reduce(p0);
+	Eigen::Matrix<double, 6, 6> Jr;
+	for (int k = 0; k < 6; ++k)
+	{
+		const double step = k < 3 ? 1e-6 : 1e-6 * std::max(1e-3, p0.tail<3>().norm());
+		Vec6 a = p0, b = p0;
+		a[k] += step;
+		b[k] -= step;
+		Vec6 d = reduce(a) - reduce(b);
+		for (const int ang : {1, 2, 5}) d[ang] = wrapToPi(d[ang]);
+		Jr.col(k) = d / (2 * step);
+	}
+	const Eigen::Matrix<double, 6, 6> C = Jr * s.cov * Jr.transpose();
+	s.L = v0.head<3>();
+	s.pose_in_landmark = v0.tail<3>();
+	s.C_L = C.topLeftCorner<3, 3>();
+	s.C_R = C.bottomRightCorner<3, 3>();
+}
+
 GeneralPose solveGeneralPose(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, double corner_sigma_px, int lm_max_iterations)
@@ -271,29 +295,10 @@ GeneralPose solveGeneralPose(
 							  ? std::numeric_limits<double>::infinity()
 							  : sols[1].rms_px / sols[0].rms_px;
 
-	// Reduction of each solution to (L, pose_in_landmark) with its Jacobian
-	// by central differences; angle differences wrapped.
-	for (PnPSolution& s : out.solutions)
-	{
-		const Vec6& p0 = s.rvec_tvec;
-		const Vec6 v0 = reduce(p0);
-		Eigen::Matrix<double, 6, 6> Jr;
-		for (int k = 0; k < 6; ++k)
-		{
-			const double step = k < 3 ? 1e-6 : 1e-6 * std::max(1e-3, p0.tail<3>().norm());
-			Vec6 a = p0, b = p0;
-			a[k] += step;
-			b[k] -= step;
-			Vec6 d = reduce(a) - reduce(b);
-			for (const int ang : {1, 2, 5}) d[ang] = wrapToPi(d[ang]);
-			Jr.col(k) = d / (2 * step);
-		}
-		const Eigen::Matrix<double, 6, 6> C = Jr * s.cov * Jr.transpose();
-		s.L = v0.head<3>();
-		s.pose_in_landmark = v0.tail<3>();
-		s.C_L = C.topLeftCorner<3, 3>();
-		s.C_R = C.bottomRightCorner<3, 3>();
-	}
+	// The best solution reduced; the other only where a caller weighs it
+	// (pose::measure() with fold_ambiguity): the reduction's 12 evaluations
+	// are most of this path's cost after the PnP.
+	reducePnPSolution(out.solutions[0]);
 	out.L = out.solutions[0].L;
 	out.pose_in_landmark = out.solutions[0].pose_in_landmark;
 	out.C_L = out.solutions[0].C_L;

@@ -428,7 +428,9 @@ Measurement measureWith(
 	if (options.fold_ambiguity && g.solutions.size() > 1 &&
 		std::isfinite(g.solutions[1].log_det_cov) && std::isfinite(best.log_det_cov))
 	{
-		const MeasurementMode second = generalMode(g.solutions[1]);
+		PnPSolution other = g.solutions[1];
+		reducePnPSolution(other);
+		const MeasurementMode second = generalMode(other);
 		fold(best, second);
 		if (m.second_mode_weight > 0 && secondModeWeight(best, second) > 0.5)
 		{

@@ -44,11 +44,17 @@ struct PnPSolution
 	/** log det (J^T C_c^-1 J)^-1: the width of this solution in Laplace's
 	 * approximation of its probability mass (pose::foldModes()). */
 	double log_det_cov = 0;
-	Eigen::Vector3d L = Eigen::Vector3d::Zero();  //!< [l2 phi1 phi2] of this solution
+	/** The solution reduced to the planar measurement (reducePnPSolution();
+	 * solveGeneralPose() reduces solutions[0] only). [l2 phi1 phi2]: */
+	Eigen::Vector3d L = Eigen::Vector3d::Zero();
 	Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< first order, from cov
 	Eigen::Vector3d pose_in_landmark = Eigen::Vector3d::Zero();	 //!< (x, y, theta) in L
 	Eigen::Matrix3d C_R = Eigen::Matrix3d::Zero();	//!< first order, from cov
 };
+
+/** Fills \a s's L, C_L, pose_in_landmark and C_R from its rvec_tvec and cov
+ * (as sightingTruth() of the pose; the Jacobian by central differences). */
+void reducePnPSolution(PnPSolution& s);
 
 /** Result of the general path. */
 struct GeneralPose
