@@ -1,7 +1,9 @@
 // Stages 1-3: smoothing, colour segmentation, connected components.
+#include "segment_kernel.h"
 #include "stages.h"
 
 #include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -10,41 +12,34 @@
 #include <cstring>
 #include <stdexcept>
 
+#define CODEMARK_STEP2_KERNEL segmentStep2Baseline
+#include "segment_step2.inl.h"
+
 namespace codemark::detect
 {
 namespace
 {
-/** The HSI predicate in integer arithmetic, with every product within 16
- * bits so that the SIMD loop evaluates it on eight pixels per instruction:
- * I >= t_I, G the largest channel, saturation 1 - min / I >= S_min (in
- * steps of 1/64), hue = 120 + 60 (B - R) / (G - min) inside the band (in
- * half degrees). */
-struct FillPredicate
+FillPredicate makePredicate(const SegmentationParams& p)
 {
-	int min_sum;  // 3 * t_I
-	int sat64;	// saturation: 3 * 64 * min <= sat64 * sum
-	int hue_lo, hue_hi;	 // hue_lo * (G - min) <= 120 * (B - R) <= hue_hi * (G - min)
+	return {
+		static_cast<int>(std::ceil(3.0 * p.min_intensity)),
+		static_cast<int>(std::lround(64.0 * (1.0 - p.min_saturation))),
+		static_cast<int>(std::lround(2.0 * (p.hue_min_deg - 120.0))),
+		static_cast<int>(std::lround(2.0 * (p.hue_max_deg - 120.0)))};
+}
 
-	explicit FillPredicate(const SegmentationParams& p)
-		: min_sum(static_cast<int>(std::ceil(3.0 * p.min_intensity))),
-		  sat64(static_cast<int>(std::lround(64.0 * (1.0 - p.min_saturation)))),
-		  hue_lo(static_cast<int>(std::lround(2.0 * (p.hue_min_deg - 120.0)))),
-		  hue_hi(static_cast<int>(std::lround(2.0 * (p.hue_max_deg - 120.0))))
-	{
-	}
-
-	bool operator()(int r, int g, int b) const
-	{
-		// HSI hue in [60, 180] deg (hexcone form) needs G to be the largest
-		// channel.
-		const int sum = r + g + b;
-		const int mn = std::min(r, b);
-		const int chroma = g - mn;
-		const int hue = 120 * (b - r);
-		return (sum >= min_sum) & (g > r) & (g > b) & (3 * 64 * mn <= sat64 * sum) &
-			   (hue >= hue_lo * chroma) & (hue <= hue_hi * chroma);
-	}
-};
+/** The predicate on one colour, as the SIMD kernels evaluate it. */
+bool isFill(const FillPredicate& pred, int r, int g, int b)
+{
+	// HSI hue in [60, 180] deg (hexcone form) needs G to be the largest
+	// channel.
+	const int sum = r + g + b;
+	const int mn = std::min(r, b);
+	const int chroma = g - mn;
+	const int hue = 120 * (b - r);
+	return (sum >= pred.min_sum) & (g > r) & (g > b) & (3 * 64 * mn <= pred.sat64 * sum) &
+		   (hue >= pred.hue_lo * chroma) & (hue <= pred.hue_hi * chroma);
+}
 
 template <int S, bool Box>
 void segmentGrid(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pred, int j_first)
@@ -80,66 +75,23 @@ void segmentGrid(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pred, i
 				g = px[1];
 				r = px[2];
 			}
-			out[j] = pred(r, g, b) ? 255 : 0;
+			out[j] = isFill(pred, r, g, b) ? 255 : 0;
 		}
 	}
 }
 
 /** Step 2 without smoothing (the default): the predicate on every other
- * pixel of every other row, 16 cells per iteration with OpenCV's universal
- * intrinsics. Returns the first column left to the scalar loop. */
-int segmentStep2Simd(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pred)
+ * pixel of every other row, a SIMD block of cells at a time (AVX2 where the
+ * CPU has it). Returns the first column left to the scalar loop. */
+int segmentStep2Simd(const cv::Mat& bgr, cv::Mat& mask, const FillPredicate& pred, SimdPath path)
 {
-#if CV_SIMD128
-	const int n16 = mask.cols / 16 * 16;
-	if (bgr.cols < 2 * n16) return 0;
-	const cv::v_int16x8 min_sum = cv::v_setall_s16(static_cast<short>(pred.min_sum - 1));
-	const cv::v_uint16x8 sat = cv::v_setall_u16(static_cast<ushort>(pred.sat64));
-	const cv::v_uint16x8 k192 = cv::v_setall_u16(192), low = cv::v_setall_u16(0x00ff);
-	const cv::v_int16x8 k120 = cv::v_setall_s16(120);
-	const cv::v_int16x8 hlo = cv::v_setall_s16(static_cast<short>(pred.hue_lo));
-	const cv::v_int16x8 hhi = cv::v_setall_s16(static_cast<short>(pred.hue_hi));
-	// The predicate on 8 cells whose channels are in the low bytes of u16s.
-	const auto cells =
-		[&](const cv::v_uint8x16& b8, const cv::v_uint8x16& g8, const cv::v_uint8x16& r8)
-	{
-		const cv::v_uint16x8 bu = cv::v_reinterpret_as_u16(b8) & low,
-							 gu = cv::v_reinterpret_as_u16(g8) & low,
-							 ru = cv::v_reinterpret_as_u16(r8) & low;
-		const cv::v_int16x8 b = cv::v_reinterpret_as_s16(bu), g = cv::v_reinterpret_as_s16(gu),
-							r = cv::v_reinterpret_as_s16(ru);
-		const cv::v_int16x8 sum = b + g + r;
-		const cv::v_uint16x8 mnu = cv::v_min(bu, ru);
-		const cv::v_int16x8 chroma = g - cv::v_reinterpret_as_s16(mnu);
-		const cv::v_int16x8 hue = cv::v_mul_wrap(k120, b - r);
-		const cv::v_int16x8 ok =
-			(sum > min_sum) & (g > r) & (g > b) &
-			cv::v_reinterpret_as_s16(
-				cv::v_mul_wrap(k192, mnu) <= cv::v_mul_wrap(sat, cv::v_reinterpret_as_u16(sum))) &
-			(hue >= cv::v_mul_wrap(hlo, chroma)) & (hue <= cv::v_mul_wrap(hhi, chroma));
-		return ok;
-	};
-	for (int i = 0; i < mask.rows; ++i)
-	{
-		const uint8_t* row = bgr.ptr<uint8_t>(2 * i);
-		uint8_t* out = mask.ptr<uint8_t>(i);
-		for (int j = 0; j < n16; j += 16)
-		{
-			// 32 pixels, of which the even ones are the cells j .. j + 15.
-			cv::v_uint8x16 b0, g0, r0, b1, g1, r1;
-			cv::v_load_deinterleave(row + 6 * j, b0, g0, r0);
-			cv::v_load_deinterleave(row + 6 * j + 48, b1, g1, r1);
-			const cv::v_int8x16 m = cv::v_pack(cells(b0, g0, r0), cells(b1, g1, r1));
-			cv::v_store(out + j, cv::v_reinterpret_as_u8(m));
-		}
-	}
-	return n16;
-#else
-	(void)bgr;
-	(void)mask;
-	(void)pred;
-	return 0;
+	const Step2Rows rows{bgr.ptr<uint8_t>(), bgr.step[0], bgr.cols, mask.ptr<uint8_t>(),
+						 mask.step[0],		 mask.rows,	  mask.cols};
+#ifdef CODEMARK_DETECT_AVX2
+	static const bool avx2 = cv::checkHardwareSupport(CV_CPU_AVX2);
+	if (path == SimdPath::Best && avx2) return segmentStep2Avx2(rows, pred);
 #endif
+	return path == SimdPath::Scalar ? 0 : segmentStep2Baseline(rows, pred);
 }
 }  // namespace
 
@@ -148,10 +100,10 @@ bool isFillColour(double r, double g, double b, const SegmentationParams& p)
 	// The integer predicate the segmentation uses, so that tests see the
 	// same answer.
 	const auto q = [](double v) { return std::clamp(static_cast<int>(std::lround(v)), 0, 255); };
-	return FillPredicate(p)(q(r), q(g), q(b));
+	return isFill(makePredicate(p), q(r), q(g), q(b));
 }
 
-cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
+cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p, SimdPath path)
 {
 	if (bgr.type() != CV_8UC3)
 		throw std::invalid_argument("segmentColour: expected a CV_8UC3 image");
@@ -159,7 +111,7 @@ cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
 	if (s < 1 || s > 4) throw std::invalid_argument("segmentColour: step_px must be 1..4");
 	cv::Mat mask(bgr.rows / s, bgr.cols / s, CV_8UC1);
 	if (mask.empty()) return mask;
-	const FillPredicate pred(p);
+	const FillPredicate pred = makePredicate(p);
 	// Dispatch to a loop specialised for the step, so the block sums unroll.
 	switch (s * 2 + (p.box_smoothing ? 1 : 0))
 	{
@@ -168,7 +120,7 @@ cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p)
 			segmentGrid<1, false>(bgr, mask, pred, 0);
 			break;
 		case 4:
-			segmentGrid<2, false>(bgr, mask, pred, segmentStep2Simd(bgr, mask, pred));
+			segmentGrid<2, false>(bgr, mask, pred, segmentStep2Simd(bgr, mask, pred, path));
 			break;
 		case 5:
 			segmentGrid<2, true>(bgr, mask, pred, 0);

@@ -25,7 +25,17 @@ namespace codemark::detect
  * floor(rows / step) x floor(cols / step) cells; cell (i, j) stands for the
  * step x step block with top-left pixel (j*step, i*step). Empty for an image
  * smaller than one block. \a bgr must be CV_8UC3. */
-cv::Mat segmentColour(const cv::Mat& bgr, const SegmentationParams& p);
+/** Which code computes the step-2 mask: the widest SIMD the CPU runs, the
+ * baseline's (SSE2 on x86-64), or scalar code only (for tests: all three
+ * must give the same mask). */
+enum class SimdPath
+{
+	Best,
+	Baseline,
+	Scalar
+};
+cv::Mat segmentColour(
+	const cv::Mat& bgr, const SegmentationParams& p, SimdPath path = SimdPath::Best);
 
 /** The segmentation predicate on one (smoothed) colour [0..255 each]. */
 bool isFillColour(double r, double g, double b, const SegmentationParams& p);
