@@ -83,38 +83,40 @@ TEST(Segmentation, MaskHasGridSizeAndMarksTheFill)
 
 TEST(Segmentation, GridMaskIsThePredicateOnEveryCell)
 {
-	// The default step-2 mask runs in SIMD over 16 cells and in scalar code
-	// over the rest of a row: both must be the predicate, cell by cell, for
-	// any colour and any width.
+	// The default step-2 mask runs in SIMD over blocks of 16 cells (32 with
+	// AVX2) and in scalar code over the rest of a row: every path must be
+	// the predicate, cell by cell, for any colour and any width.
 	cv::RNG rng(7);
 	for (const cv::Size size : {cv::Size(640, 48), cv::Size(67, 33), cv::Size(31, 9)})
 		for (const int step : {1, 2, 3})
-		{
-			cv::Mat img(size, CV_8UC3);
-			rng.fill(img, cv::RNG::UNIFORM, 0, 256);
-			// Half the pixels near green, where the predicate's bounds are.
-			for (int y = 0; y < img.rows; ++y)
-				for (int x = 0; x < img.cols; x += 2)
-				{
-					auto& px = img.at<cv::Vec3b>(y, x);
-					px[1] =
-						cv::saturate_cast<uint8_t>(std::max(px[0], px[2]) + rng.uniform(-5, 60));
-				}
-			SegmentationParams p;
-			p.step_px = step;
-			const cv::Mat m = segmentColour(img, p);
-			int fill = 0;
-			for (int i = 0; i < m.rows; ++i)
-				for (int j = 0; j < m.cols; ++j)
-				{
-					const auto& px = img.at<cv::Vec3b>(i * step, j * step);
-					const bool want = isFillColour(px[2], px[1], px[0], p);
-					ASSERT_EQ(m.at<uint8_t>(i, j) != 0, want)
-						<< size << " step " << step << " cell " << i << "," << j;
-					fill += want;
-				}
-			EXPECT_GT(fill, 0);
-		}
+			for (const SimdPath path : {SimdPath::Best, SimdPath::Baseline, SimdPath::Scalar})
+			{
+				cv::Mat img(size, CV_8UC3);
+				rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+				// Half the pixels near green, where the predicate's bounds are.
+				for (int y = 0; y < img.rows; ++y)
+					for (int x = 0; x < img.cols; x += 2)
+					{
+						auto& px = img.at<cv::Vec3b>(y, x);
+						px[1] = cv::saturate_cast<uint8_t>(
+							std::max(px[0], px[2]) + rng.uniform(-5, 60));
+					}
+				SegmentationParams p;
+				p.step_px = step;
+				const cv::Mat m = segmentColour(img, p, path);
+				int fill = 0;
+				for (int i = 0; i < m.rows; ++i)
+					for (int j = 0; j < m.cols; ++j)
+					{
+						const auto& px = img.at<cv::Vec3b>(i * step, j * step);
+						const bool want = isFillColour(px[2], px[1], px[0], p);
+						ASSERT_EQ(m.at<uint8_t>(i, j) != 0, want)
+							<< size << " step " << step << " path " << static_cast<int>(path)
+							<< " cell " << i << "," << j;
+						fill += want;
+					}
+				EXPECT_GT(fill, 0);
+			}
 }
 
 TEST(Segmentation, TinyAndEmptyImagesGiveAnEmptyMask)
@@ -354,6 +356,36 @@ std::vector<int> stepProfile(double x0, double sigma, int n, double hi = 230)
 	return v;
 }
 }  // namespace
+
+TEST(Subpixel, PixelStepIsTheIntegratedBlurredStep)
+{
+	// A unit step at 0 blurred by sigma, integrated over the pixel [x - 1/2,
+	// x + 1/2]: sigma (F(z+) - F(z-)), F(z) = z Phi(z) + phi(z), from
+	// std::erfc here; pixelSteps() interpolates a table. Its derivatives in
+	// x and sigma against central differences of the exact value.
+	const auto exact = [](double x, double sigma)
+	{
+		const auto F = [](double z) {
+			return z * 0.5 * std::erfc(-z / std::sqrt(2.0)) +
+				   std::exp(-0.5 * z * z) / std::sqrt(2 * M_PI);
+		};
+		return sigma * (F((x + 0.5) / sigma) - F((x - 0.5) / sigma));
+	};
+	std::mt19937 rng(3);
+	std::uniform_real_distribution<double> ux(-12, 12), us(0.05, 3);
+	for (int t = 0; t < 20000; ++t)
+	{
+		const double x = ux(rng), sigma = us(rng), h = 1e-5;
+		const PixelStep s = pixelStep(x, sigma);
+		ASSERT_NEAR(s.value, exact(x, sigma), 2e-8) << x << " " << sigma;
+		ASSERT_NEAR(s.d_x, (exact(x + h, sigma) - exact(x - h, sigma)) / (2 * h), 2e-6);
+		ASSERT_NEAR(s.d_sigma, (exact(x, sigma + h) - exact(x, sigma - h)) / (2 * h), 2e-6);
+	}
+	// Five neighbouring samples share their boundaries: the same values.
+	std::array<PixelStep, 5> st;
+	pixelSteps(-2.3, 0.7, 5, st.data());
+	for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(st[i].value, pixelStep(-2.3 + i, 0.7).value);
+}
 
 TEST(Subpixel, CentroidLocatesABlurredStep)
 {

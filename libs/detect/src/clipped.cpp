@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -229,15 +230,62 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 }
 }  // namespace
 
+namespace
+{
+/** The standard normal's CDF \a P and density \a f at \a z by cubic
+ * Hermite interpolation in a table of both (and of their derivatives f and
+ * -z f) every 1/32 over [-8.5, 8.5]: |error| < 5e-9 in either, with no
+ * exponential or division. Written by hand: std::erfc beside std::exp cost
+ * several times as much, and pixelSteps() is where the thin-frame and
+ * step-peak fits spend most of their time. Beyond |z| = 8.5 the tails are
+ * 0 and 1 to 1e-17. */
+inline void normalCdfPdf(double z, double& P, double& f)
+{
+	constexpr double kEnd = 8.5, kPerUnit = 32, kH = 1 / kPerUnit;
+	constexpr int kNodes = static_cast<int>(2 * kEnd * kPerUnit) + 1;
+	struct Node
+	{
+		double P, f, df;  // Phi, phi and phi' = -z phi at the node
+	};
+	static const std::array<Node, kNodes> table = []
+	{
+		std::array<Node, kNodes> t{};
+		for (int k = 0; k < kNodes; ++k)
+		{
+			const double u = -kEnd + k * kH;
+			t[k] = {Phi(u), phi(u), -u * phi(u)};
+		}
+		return t;
+	}();
+	if (!(std::abs(z) < kEnd))
+	{
+		P = z > 0 ? 1.0 : 0.0;
+		f = 0;
+		return;
+	}
+	const double u = (z + kEnd) * kPerUnit;
+	const int k = std::min(static_cast<int>(u), kNodes - 2);
+	const double s = u - k, r = 1 - s;
+	const double h00 = (1 + 2 * s) * r * r, h01 = s * s * (3 - 2 * s);
+	const double h10 = kH * s * r * r, h11 = -kH * s * s * r;
+	const Node &a = table[k], &b = table[k + 1];
+	P = h00 * a.P + h01 * b.P + h10 * a.f + h11 * b.f;
+	f = h00 * a.f + h01 * b.f + h10 * a.df + h11 * b.df;
+}
+}  // namespace
+
 void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 {
 	// Sample i covers [x0 + i - 1/2, x0 + i + 1/2]: neighbours share a
 	// boundary, so count + 1 evaluations of Phi and phi serve all. The
 	// integral of Phi is z Phi(z) + phi(z).
-	double zm = (x0 - 0.5) / sigma, Pm = Phi(zm), fm = phi(zm);
+	double zm = (x0 - 0.5) / sigma, Pm, fm;
+	normalCdfPdf(zm, Pm, fm);
 	for (int i = 0; i < count; ++i)
 	{
-		const double zp = (x0 + i + 0.5) / sigma, Pp = Phi(zp), fp = phi(zp);
+		const double zp = (x0 + i + 0.5) / sigma;
+		double Pp, fp;
+		normalCdfPdf(zp, Pp, fp);
 		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
 		zm = zp;
 		Pm = Pp;
@@ -317,25 +365,31 @@ std::optional<FillLevel> fitFillLevel(
 	level.profiles = m;
 	level.i0 = i0;
 	level.i1 = i1;
-	// Start: least squares on the unclipped samples.
+	// The unclipped samples enter the likelihood through their sums alone
+	// (A, bv, svv); the clipped ones each through the normal's tail at their
+	// own design point.
 	Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
 	Eigen::Vector3d bv = Eigen::Vector3d::Zero();
-	int clipped = 0, unclipped = 0;
+	double svv = 0;
+	std::vector<Eigen::Vector3d> x_clipped;
+	int unclipped = 0;
 	for (int j = 0; j < m; ++j)
 		for (int i = i0; i <= i1; ++i)
 		{
 			const int v = g_profiles[j * n + i];
+			const Eigen::Vector3d x = level.design(j, i);
 			if (v >= 255)
 			{
-				++clipped;
+				x_clipped.push_back(x);
 				continue;
 			}
 			++unclipped;
-			const Eigen::Vector3d x = level.design(j, i);
 			A += x * x.transpose();
 			bv += v * x;
+			svv += double(v) * v;
 		}
-	if (unclipped < 10 || clipped < 10) return std::nullopt;
+	if (unclipped < 10 || x_clipped.size() < 10) return std::nullopt;
+	// Start: least squares on the unclipped samples.
 	Eigen::Vector3d beta = (A + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(bv);
 	double ss = 0;
 	for (int j = 0; j < m; ++j)
@@ -349,46 +403,39 @@ std::optional<FillLevel> fitFillLevel(
 	th << beta / sigma0, 1 / sigma0;
 	const auto logLik = [&](const Eigen::Vector4d& t, Eigen::Vector4d* g, Eigen::Matrix4d* H)
 	{
-		double ll = 0;
-		if (g) g->setZero();
-		if (H) H->setZero();
 		const Eigen::Vector3d gamma = t.head<3>();
 		const double tau = t[3];
-		for (int j = 0; j < m; ++j)
-			for (int i = i0; i <= i1; ++i)
-			{
-				const int v = g_profiles[j * n + i];
-				const Eigen::Vector3d x = level.design(j, i);
-				Eigen::Vector4d dz;	 // d(residual or z)/d(gamma, tau)
-				if (v < 255)
-				{
-					const double r = tau * v - x.dot(gamma);
-					ll += std::log(tau) - 0.5 * r * r;
-					dz << -x, v;
-					if (g)
-					{
-						*g -= r * dz;
-						(*g)[3] += 1 / tau;
-					}
-					if (H)
-					{
-						*H -= dz * dz.transpose();
-						(*H)(3, 3) -= 1 / (tau * tau);
-					}
-				}
-				else
-				{
-					// log(1 - Phi(z)) = log Phi(-z): censoredTerm at -z.
-					const double z = tau * c - x.dot(gamma);
-					double nll, d1, d2;
-					censoredTerm(-z, nll, d1, d2);
-					ll -= nll;
-					dz << -x, c;
-					// d/dz (-nll(-z)) = d1, d2/dz2 = -d2.
-					if (g) *g += d1 * dz;
-					if (H) *H -= d2 * dz * dz.transpose();
-				}
-			}
+		// Unclipped: r = tau v - x.gamma, log-likelihood log(tau) - r^2 / 2
+		// each; dr/d(gamma, tau) = (-x, v).
+		const Eigen::Vector3d A_gamma = A * gamma;
+		const double bv_gamma = bv.dot(gamma);
+		double ll = unclipped * std::log(tau) -
+					0.5 * (tau * tau * svv - 2 * tau * bv_gamma + gamma.dot(A_gamma));
+		if (g)
+		{
+			g->head<3>() = tau * bv - A_gamma;
+			(*g)[3] = unclipped / tau - (tau * svv - bv_gamma);
+		}
+		if (H)
+		{
+			H->topLeftCorner<3, 3>() = -A;
+			H->topRightCorner<3, 1>() = bv;
+			H->bottomLeftCorner<1, 3>() = bv.transpose();
+			(*H)(3, 3) = -svv - unclipped / (tau * tau);
+		}
+		for (const Eigen::Vector3d& x : x_clipped)
+		{
+			// log(1 - Phi(z)) = log Phi(-z): censoredTerm at -z.
+			const double z = tau * c - x.dot(gamma);
+			double nll, d1, d2;
+			censoredTerm(-z, nll, d1, d2);
+			ll -= nll;
+			Eigen::Vector4d dz;	 // dz/d(gamma, tau)
+			dz << -x, c;
+			// d/dz (-nll(-z)) = d1, d2/dz2 = -d2.
+			if (g) *g += d1 * dz;
+			if (H) *H -= d2 * dz * dz.transpose();
+		}
 		return ll;
 	};
 	double ll = logLik(th, nullptr, nullptr);
