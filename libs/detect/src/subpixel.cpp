@@ -335,14 +335,16 @@ std::optional<double> thinFrameOffset(
 	const auto W0 = levelOver(x0, -frame_px - 3, false, false);
 	Vec7 q;
 	q << W0.value_or(*M0), *M0, *K0, *G0, fixed_sigma > 0 ? fixed_sigma : 0.8, 1.0, 0.0;
+	// Bounds of the blur, the margin's width and the offset (t[4..6]).
+	const double lo_bound[3] = {0.2, 0.25 * frame_px, -1.0}, hi_bound[3] = {2.5, kBeyond, 1.0};
 	const auto clampParams = [&](Vec7& t)
 	{
-		t[4] = fixed_sigma > 0 ? fixed_sigma : std::clamp(t[4], 0.2, 2.5);
+		t[4] = fixed_sigma > 0 ? fixed_sigma : std::clamp(t[4], lo_bound[0], hi_bound[0]);
 		// The sheet's white above the frame's black, the fill above it too.
 		t[1] = std::max(t[1], t[2] + 10);
 		t[3] = std::max(t[3], t[2] + 10);
-		t[5] = std::clamp(t[5], 0.25 * frame_px, kBeyond);
-		t[6] = std::clamp(t[6], -1.0, 1.0);
+		t[5] = std::clamp(t[5], lo_bound[1], hi_bound[1]);
+		t[6] = std::clamp(t[6], lo_bound[2], hi_bound[2]);
 	};
 	const auto residuals = [&](const Vec7& t, Mat7* JtJ, Vec7* Jtr)
 	{
@@ -377,11 +379,25 @@ std::optional<double> thinFrameOffset(
 	Vec7 g;
 	double cost = residuals(q, &H, &g), mu = 1e-3;
 	bool converged = false;
+	// Box bounds of the blur, the margin and the offset: a parameter at its
+	// bound whose gradient points out of the box stays there for the step
+	// (projected Newton). Clamping the full step instead left the others'
+	// step wrong for as long as the margin sat on its bound (a narrow
+	// margin): the fit then zigzagged to the iteration limit.
 	for (int it = 0; it < 40 && !converged; ++it)
 	{
 		Mat7 A = H;
 		A.diagonal() += mu * H.diagonal().cwiseMax(1e-9);
-		Vec7 cand = q - A.ldlt().solve(g);
+		Vec7 g_free = g;
+		for (int k = 4; k < 7; ++k)
+			if ((q[k] <= lo_bound[k - 4] && g[k] > 0) || (q[k] >= hi_bound[k - 4] && g[k] < 0))
+			{
+				A.row(k).setZero();
+				A.col(k).setZero();
+				A(k, k) = 1;
+				g_free[k] = 0;
+			}
+		Vec7 cand = q - A.ldlt().solve(g_free);
 		if (!cand.allFinite()) return std::nullopt;
 		clampParams(cand);
 		Mat7 Hc;
