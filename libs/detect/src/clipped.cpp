@@ -68,11 +68,67 @@ constexpr double kMaxOffsetSdPx = 0.05;
 constexpr double kMinRbStep = 12;
 constexpr double kMinRatioSamples = 20;
 constexpr double kUnclippedG = 240;
+/** Clipped samples of a band whose tail terms fitFillLevel() evaluates. */
+constexpr size_t kMaxClippedTerms = 160;
 /** Profiles of a side used by the side's fit, evenly spread. */
 constexpr size_t kMaxProfiles = 20;
 
 double Phi(double u) { return 0.5 * std::erfc(-u / kSqrt2); }
 double phi(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
+
+/** The standard normal's CDF \a P and density \a f at \a z by cubic
+ * Hermite interpolation in a table of both (and of their derivatives f and
+ * -z f) every 1/32 over [-8.5, 8.5]: |error| < 5e-9 in either, with no
+ * exponential or division. Written by hand: std::erfc beside std::exp cost
+ * several times as much, and pixelSteps() is where the thin-frame and
+ * step-peak fits spend most of their time. Beyond |z| = 8.5 the tails are
+ * 0 and 1 to 1e-17. */
+inline void normalCdfPdf(double z, double& P, double& f)
+{
+	constexpr double kEnd = 8.5, kPerUnit = 32, kH = 1 / kPerUnit;
+	constexpr int kNodes = static_cast<int>(2 * kEnd * kPerUnit) + 1;
+	struct Node
+	{
+		double P, f, df;  // Phi, phi and phi' = -z phi at the node
+	};
+	static const std::array<Node, kNodes> table = []
+	{
+		std::array<Node, kNodes> t{};
+		for (int k = 0; k < kNodes; ++k)
+		{
+			const double u = -kEnd + k * kH;
+			t[k] = {Phi(u), phi(u), -u * phi(u)};
+		}
+		return t;
+	}();
+	if (!(std::abs(z) < kEnd))
+	{
+		P = z > 0 ? 1.0 : 0.0;
+		f = 0;
+		return;
+	}
+	const double u = (z + kEnd) * kPerUnit;
+	const int k = std::min(static_cast<int>(u), kNodes - 2);
+	const double s = u - k, r = 1 - s;
+	const double h00 = (1 + 2 * s) * r * r, h01 = s * s * (3 - 2 * s);
+	const double h10 = kH * s * r * r, h11 = -kH * s * s * r;
+	const Node &a = table[k], &b = table[k + 1];
+	P = h00 * a.P + h01 * b.P + h10 * a.f + h11 * b.f;
+	f = h00 * a.f + h01 * b.f + h10 * a.df + h11 * b.df;
+}
+/** normalCdfPdf() where the CDF is needed to a relative accuracy (its
+ * logarithm, a ratio to it): the table's absolute error (< 5e-9) is a
+ * relative one under 2e-5 above z = -3.5; further out, erfc's. */
+inline void normalCdfPdfRelative(double z, double& P, double& f)
+{
+	if (z > -3.5)
+		normalCdfPdf(z, P, f);
+	else
+	{
+		P = Phi(z);
+		f = phi(z);
+	}
+}
 
 /** -log Phi(z) and its first two derivatives with respect to z (through
  * the inverse Mills ratio), stable far in the lower tail. */
@@ -86,8 +142,9 @@ void censoredTerm(double z, double& nll, double& d1, double& d2)
 		d2 = 1;
 		return;
 	}
-	const double P = Phi(z);
-	const double lambda = phi(z) / P;
+	double P, f;
+	normalCdfPdfRelative(z, P, f);
+	const double lambda = f / P;
 	nll = -std::log(P);
 	d1 = -lambda;
 	d2 = lambda * (z + lambda);
@@ -230,50 +287,6 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 }
 }  // namespace
 
-namespace
-{
-/** The standard normal's CDF \a P and density \a f at \a z by cubic
- * Hermite interpolation in a table of both (and of their derivatives f and
- * -z f) every 1/32 over [-8.5, 8.5]: |error| < 5e-9 in either, with no
- * exponential or division. Written by hand: std::erfc beside std::exp cost
- * several times as much, and pixelSteps() is where the thin-frame and
- * step-peak fits spend most of their time. Beyond |z| = 8.5 the tails are
- * 0 and 1 to 1e-17. */
-inline void normalCdfPdf(double z, double& P, double& f)
-{
-	constexpr double kEnd = 8.5, kPerUnit = 32, kH = 1 / kPerUnit;
-	constexpr int kNodes = static_cast<int>(2 * kEnd * kPerUnit) + 1;
-	struct Node
-	{
-		double P, f, df;  // Phi, phi and phi' = -z phi at the node
-	};
-	static const std::array<Node, kNodes> table = []
-	{
-		std::array<Node, kNodes> t{};
-		for (int k = 0; k < kNodes; ++k)
-		{
-			const double u = -kEnd + k * kH;
-			t[k] = {Phi(u), phi(u), -u * phi(u)};
-		}
-		return t;
-	}();
-	if (!(std::abs(z) < kEnd))
-	{
-		P = z > 0 ? 1.0 : 0.0;
-		f = 0;
-		return;
-	}
-	const double u = (z + kEnd) * kPerUnit;
-	const int k = std::min(static_cast<int>(u), kNodes - 2);
-	const double s = u - k, r = 1 - s;
-	const double h00 = (1 + 2 * s) * r * r, h01 = s * s * (3 - 2 * s);
-	const double h10 = kH * s * r * r, h11 = -kH * s * s * r;
-	const Node &a = table[k], &b = table[k + 1];
-	P = h00 * a.P + h01 * b.P + h10 * a.f + h11 * b.f;
-	f = h00 * a.f + h01 * b.f + h10 * a.df + h11 * b.df;
-}
-}  // namespace
-
 void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 {
 	// Sample i covers [x0 + i - 1/2, x0 + i + 1/2]: neighbours share a
@@ -389,6 +402,20 @@ std::optional<FillLevel> fitFillLevel(
 			svv += double(v) * v;
 		}
 	if (unclipped < 10 || x_clipped.size() < 10) return std::nullopt;
+	// Each clipped sample costs a tail probability per evaluation: at most
+	// kMaxClippedTerms of them, evenly spread over the band, stand for all
+	// (weighted). The level's error grows by at most sqrt(n / kept) in the
+	// tail's share of the information, hundredths of a grey level, a
+	// thousandth of a pixel on the imputed edges.
+	double w_clipped = 1;
+	if (x_clipped.size() > kMaxClippedTerms)
+	{
+		std::vector<Eigen::Vector3d> kept(kMaxClippedTerms);
+		for (size_t k = 0; k < kMaxClippedTerms; ++k)
+			kept[k] = x_clipped[k * x_clipped.size() / kMaxClippedTerms];
+		w_clipped = double(x_clipped.size()) / kMaxClippedTerms;
+		x_clipped = std::move(kept);
+	}
 	// Start: least squares on the unclipped samples.
 	Eigen::Vector3d beta = (A + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(bv);
 	double ss = 0;
@@ -429,22 +456,23 @@ std::optional<FillLevel> fitFillLevel(
 			const double z = tau * c - x.dot(gamma);
 			double nll, d1, d2;
 			censoredTerm(-z, nll, d1, d2);
-			ll -= nll;
+			ll -= w_clipped * nll;
 			Eigen::Vector4d dz;	 // dz/d(gamma, tau)
 			dz << -x, c;
 			// d/dz (-nll(-z)) = d1, d2/dz2 = -d2.
-			if (g) *g += d1 * dz;
-			if (H) *H -= d2 * dz * dz.transpose();
+			if (g) *g += (w_clipped * d1) * dz;
+			if (H) *H -= (w_clipped * d2) * dz * dz.transpose();
 		}
 		return ll;
 	};
-	double ll = logLik(th, nullptr, nullptr);
+	// Newton with step halving; each candidate's derivatives come with its
+	// likelihood (a full step is nearly always taken: one pass a step).
+	Eigen::Vector4d g;
+	Eigen::Matrix4d H;
+	double ll = logLik(th, &g, &H);
 	bool converged = false;
 	for (int it = 0; it < 30 && !converged; ++it)
 	{
-		Eigen::Vector4d g;
-		Eigen::Matrix4d H;
-		logLik(th, &g, &H);
 		const Eigen::Vector4d step = (-H).ldlt().solve(g);
 		if (!step.allFinite()) return std::nullopt;
 		double scale = 1;
@@ -452,12 +480,16 @@ std::optional<FillLevel> fitFillLevel(
 		{
 			const Eigen::Vector4d cand = th + scale * step;
 			if (!(cand[3] > 0)) continue;
-			const double lc = logLik(cand, nullptr, nullptr);
+			Eigen::Vector4d gc;
+			Eigen::Matrix4d Hc;
+			const double lc = logLik(cand, &gc, &Hc);
 			if (lc >= ll)
 			{
 				converged = lc - ll < 1e-9 * std::max(1.0, std::abs(ll));
 				th = cand;
 				ll = lc;
+				g = gc;
+				H = Hc;
 				break;
 			}
 		}
@@ -483,9 +515,11 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
 	const int m = static_cast<int>(g_profiles.size()) / n;
 	const auto expected = [&](double mu)
 	{
-		const double z = (c - mu) / level.sigma, tail = Phi(-z);
+		const double z = (c - mu) / level.sigma;
+		double tail, f;
+		normalCdfPdfRelative(-z, tail, f);
 		const double e =
-			tail > 1e-12 ? mu + level.sigma * phi(z) / tail : c + level.sigma / std::max(1.0, z);
+			tail > 1e-12 ? mu + level.sigma * f / tail : c + level.sigma / std::max(1.0, z);
 		return static_cast<int>(std::lround(std::max(c, e)));
 	};
 	// A flat level (the common case) has one expectation for every sample.
