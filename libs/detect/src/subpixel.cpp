@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace codemark::detect
 {
@@ -180,10 +181,12 @@ std::optional<double> locateRisingEdge(
 					double v2 = 0;
 					const double off = peakOffset(a, b, c, v2);
 					if (v2 <= 0) break;
+					const bool settled = std::abs(peak + off - e) < 1e-4;
 					e = peak + off;
 					var = v2;
 					amp = b;
 					fitted = {a, b, c};
+					if (settled) break;
 				}
 			}
 		}
@@ -369,10 +372,17 @@ std::optional<double> thinFrameOffset(
 						? 0.0
 						: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
 					(M - W) * s1.d_x, -((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
-				*JtJ += d.w * J * J.transpose();
-				*Jtr += d.w * r * J;
+				// The upper triangle only (mirrored below): half the
+				// products of the outer product, in this fit's inner loop.
+				const Vec7 wJ = d.w * J;
+				for (int c = 0; c < 7; ++c)
+					for (int rw = 0; rw <= c; ++rw) (*JtJ)(rw, c) += wJ[rw] * J[c];
+				*Jtr += r * wJ;
 			}
 		}
+		if (JtJ)
+			for (int c = 0; c < 7; ++c)
+				for (int rw = c + 1; rw < 7; ++rw) (*JtJ)(rw, c) = (*JtJ)(c, rw);
 		return cost;
 	};
 	Mat7 H;
@@ -579,6 +589,9 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const int n = 2 * half + 1;
 		const int lo = half - p.search_px, hi = half + p.search_px;
 		std::vector<int> g_prof, rb_prof, pos, origin;
+		const size_t max_profiles = static_cast<size_t>(std::max(0.0, s1 - s0 + 1));
+		g_prof.reserve(max_profiles * n);
+		rb_prof.reserve(max_profiles * n);
 		int saturated = 0, clipped = 0;
 		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
 		{
@@ -588,14 +601,20 @@ std::optional<RefinedQuad> refineQuadrangle(
 			const int c_first = c0 - half, c_last = c0 + half;
 			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H))
 				continue;
-			double fill_sum = 0;
-			for (int i = 0; i < n; ++i)
+			// Sample i at pixel c0 + inward * (i - half) across: a step of
+			// 3 bytes along a row, a row's bytes down a column.
+			const std::ptrdiff_t stride =
+				inward * (along == 1 ? 3 : static_cast<std::ptrdiff_t>(bgr.step[0]));
+			const uint8_t* px = along == 1 ? bgr.ptr<uint8_t>(s) + 3 * (c0 - inward * half)
+										   : bgr.ptr<uint8_t>(c0 - inward * half) + 3 * s;
+			const size_t at = g_prof.size();
+			g_prof.resize(at + n);
+			rb_prof.resize(at + n);
+			int fill_sum = 0;
+			for (int i = 0; i < n; ++i, px += stride)
 			{
-				const int c = c0 + inward * (i - half);
-				const uint8_t* px =
-					along == 1 ? bgr.ptr<uint8_t>(s) + 3 * c : bgr.ptr<uint8_t>(c) + 3 * s;
-				g_prof.push_back(px[1]);
-				rb_prof.push_back(-(px[0] + px[2]));
+				g_prof[at + i] = px[1];
+				rb_prof[at + i] = -(px[0] + px[2]);
 				if (i >= hi + 2) fill_sum += px[1];
 			}
 			if (fill_sum >= p.saturation_level * (n - hi - 2))
