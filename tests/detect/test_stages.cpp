@@ -385,6 +385,17 @@ TEST(Subpixel, PixelStepIsTheIntegratedBlurredStep)
 	std::array<PixelStep, 5> st;
 	pixelSteps(-2.3, 0.7, 5, st.data());
 	for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(st[i].value, pixelStep(-2.3 + i, 0.7).value);
+	// At arbitrary positions with one blur: the same steps.
+	const double at[3] = {-4.1, 0.37, 2.9};
+	std::array<PixelStep, 3> sa;
+	pixelStepsAt(at, 3, 0.8, sa.data());
+	for (int i = 0; i < 3; ++i)
+	{
+		const PixelStep one = pixelStep(at[i], 0.8);
+		EXPECT_NEAR(sa[i].value, one.value, 1e-14);
+		EXPECT_NEAR(sa[i].d_x, one.d_x, 1e-14);
+		EXPECT_NEAR(sa[i].d_sigma, one.d_sigma, 1e-14);
+	}
 }
 
 TEST(Subpixel, CentroidLocatesABlurredStep)

@@ -306,6 +306,19 @@ void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 	}
 }
 
+void pixelStepsAt(const double* x, int count, double sigma, PixelStep* out)
+{
+	const double inv_sigma = 1 / sigma;
+	for (int i = 0; i < count; ++i)
+	{
+		const double zm = (x[i] - 0.5) * inv_sigma, zp = (x[i] + 0.5) * inv_sigma;
+		double Pm, fm, Pp, fp;
+		normalCdfPdf(zm, Pm, fm);
+		normalCdfPdf(zp, Pp, fp);
+		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+	}
+}
+
 PixelStep pixelStep(double x, double sigma)
 {
 	PixelStep s;

@@ -167,6 +167,8 @@ PixelStep pixelStep(double x, double sigma);
  * pixels' common boundaries (count + 1 evaluations of the normal's CDF
  * and density instead of 2 count). */
 void pixelSteps(double x0, double sigma, int count, PixelStep* out);
+/** pixelStep() at each of \a count positions \a x (one blur), into \a out. */
+void pixelStepsAt(const double* x, int count, double sigma, PixelStep* out);
 
 /** The index in lo..hi (1 <= lo, hi <= n - 2) of the largest central
  * difference v[i + 1] - v[i - 1], the first of equals: an edge's steepest

@@ -358,8 +358,10 @@ std::optional<double> thinFrameOffset(
 		{
 			// The frame's and the margin's edges move with the inner one.
 			const double x = d.x - t[6];
-			const PixelStep s1 = pixelStep(x + frame_px + t[5], t[4]),
-							s2 = pixelStep(x + frame_px, t[4]), s3 = pixelStep(x, t[4]);
+			const double at[3] = {x + frame_px + t[5], x + frame_px, x};
+			std::array<PixelStep, 3> st;
+			pixelStepsAt(at, 3, t[4], st.data());
+			const PixelStep &s1 = st[0], &s2 = st[1], &s3 = st[2];
 			const double W = t[0], M = t[1], K = t[2], G = t[3];
 			const double model = W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value;
 			const double r = model - d.v;
