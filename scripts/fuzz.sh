@@ -1,25 +1,22 @@
 #!/usr/bin/env bash
-# Builds codemark's libFuzzer targets with clang-14 (build-fuzz/, CODEMARK_FUZZ=ON)
+# Builds codemark's libFuzzer targets with clang-14 (build-asan/, shared with
+# scripts/sanitize.sh: see scripts/asan-build.sh)
 # and runs each for SECONDS (default 60) from its seed corpus in
 # fuzz/corpus/<target>/. Fails on the first crash, leak, timeout or
 # out-of-memory; the reproducer is left in fuzz/crashes/<target>/.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 600 fuzz_map
 # Environment:
-# FUZZ_BUILD_DIR (default build-fuzz), FUZZ_NO_BUILD=1 to skip the build.
+# ASAN_BUILD_DIR (default build-asan), FUZZ_NO_BUILD=1 to skip the build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=60
 if [[ $# -gt 0 && "$1" =~ ^[0-9]+$ ]]; then SECONDS_PER_TARGET=$1; shift; fi
 TARGETS=("$@")
 [[ ${#TARGETS[@]} -eq 0 ]] && TARGETS=(fuzz_detector fuzz_map fuzz_camera fuzz_deserialize)
-BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
-CXX_CLANG=$(command -v clang++-14 || command -v clang++)
-
-if [[ "${FUZZ_NO_BUILD:-0}" != 1 ]]; then
-  cmake -S . -B "$BUILD" -DCMAKE_CXX_COMPILER="$CXX_CLANG" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCODEMARK_FUZZ=ON -DCODEMARK_BUILD_BENCH=OFF -DCODEMARK_BUILD_TESTS=OFF >/dev/null
-  cmake --build "$BUILD" -j"$(nproc)" --target "${TARGETS[@]}"
-fi
+# shellcheck source=scripts/asan-build.sh
+source scripts/asan-build.sh
+BUILD=$ASAN_BUILD_DIR
+[[ "${FUZZ_NO_BUILD:-0}" == 1 ]] || asan_build "${TARGETS[@]}"
 
 # OpenCV and MRPT are not instrumented; their one-time allocations are not leaks of ours.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0:abort_on_error=1:symbolize=1}

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libraries' unit tests with AddressSanitizer + UndefinedBehavior-
-# Sanitizer (gcc, build-asan/, CODEMARK_SANITIZE=ON) and runs them with ctest;
+# Sanitizer (clang, build-asan/, shared with scripts/fuzz.sh: see
+# scripts/asan-build.sh) and runs them with ctest;
 # the first error stops the test that hit it (halt_on_error) and fails the run.
 # The slow simulation suites (renders, Monte Carlo, filter runs), the filters
 # (whose template-heavy EKF-SLAM takes minutes to compile) and the
@@ -12,7 +13,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 TARGETS=("$@")
 [[ ${#TARGETS[@]} -eq 0 ]] && TARGETS=(test_landmark test_print test_sim test_pose test_mrpt_plugin)
-BUILD=${ASAN_BUILD_DIR:-build-asan}
+# shellcheck source=scripts/asan-build.sh
+source scripts/asan-build.sh
+BUILD=$ASAN_BUILD_DIR
 
 # Leak reports from MRPT's and OpenCV's one-time static allocations are
 # suppressed in scripts/lsan.supp (see there); everything else fails.
@@ -20,9 +23,10 @@ export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:strict_stri
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp:print_suppressions=0"
 
-cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCODEMARK_SANITIZE=ON \
-  -DCODEMARK_BUILD_BENCH=OFF >/dev/null
-cmake --build "$BUILD" -j"$(nproc)" --target "${TARGETS[@]}"
+# The fuzz targets are built with them (2 cores kept busy, scripts/fuzz.sh
+# then finds them built) unless FUZZ_TARGETS is set empty.
+read -r -a FUZZ <<<"${FUZZ_TARGETS-fuzz_detector fuzz_map fuzz_camera fuzz_deserialize}"
+asan_build "${TARGETS[@]}" "${FUZZ[@]}"
 # Only the tests whose command is one of the executables built here (the
 # app-level tests and the other suites register too, but are not built).
 regex=$(ctest --test-dir "$BUILD" --show-only=json-v1 | python3 -c '
