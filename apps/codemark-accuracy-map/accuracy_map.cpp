@@ -3,6 +3,7 @@
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/pose/closed_form.h>
+#include <codemark/pose/consistency.h>
 #include <codemark/pose/general.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/sim/render.h>
@@ -643,6 +644,37 @@ std::string writeResults(
 					  << fmt(chi2Quantile(0.975, 3.0 * n) / n, 2) << "]";
 				else
 					s << "-";
+			}
+			s << "\n";
+			// A cell's renders share its geometry and so the detector's
+			// systematic error there: the chi-square bands above assume
+			// independent sightings. With the cells as the units
+			// (pose/consistency.h) the interval of the mean is honest.
+			s << "cells as units (95% interval of the mean NEES; design effect):";
+			for (const bool small_phi2 : {false, true})
+			{
+				s << (small_phi2 ? "; where sigma(phi2) <= 2 deg" : " all");
+				for (int k = 0; k < 2; ++k)
+				{
+					std::vector<pose::NeesCluster> clusters;
+					for (const auto& c : cells)
+					{
+						if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
+							continue;
+						const MethodErrors& e = k ? c.general : c.closed_form;
+						// finish() made e.nees the cell's mean.
+						clusters.push_back(
+							small_phi2 ? pose::NeesCluster{e.nees_small_phi2_sum, e.nees_small_phi2_n}
+									   : pose::NeesCluster{e.nees * e.detected, e.detected});
+					}
+					const pose::ClusteredMean m = pose::clusteredMean(clusters, 3);
+					s << (k ? ", gen " : " cf ");
+					if (m.clusters >= 2)
+						s << fmt(m.mean, 2) << " [" << fmt(m.low, 2) << ", " << fmt(m.high, 2)
+						  << "] " << fmt(m.design_effect, 1);
+					else
+						s << "-";
+				}
 			}
 			s << "\n";
 		}
