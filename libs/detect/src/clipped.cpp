@@ -287,11 +287,20 @@ bool clippedEvenly(const std::vector<int>& g_profiles, int n, int m, int i0, int
 }
 }  // namespace
 
+namespace
+{
+/** The pixel between the boundaries z_m and z_p (in sigmas, with Phi and
+ * phi there): the integral of Phi is z Phi(z) + phi(z). */
+PixelStep stepBetween(double sigma, double zm, double Pm, double fm, double zp, double Pp, double fp)
+{
+	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+}
+}  // namespace
+
 void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 {
 	// Sample i covers [x0 + i - 1/2, x0 + i + 1/2]: neighbours share a
-	// boundary, so count + 1 evaluations of Phi and phi serve all. The
-	// integral of Phi is z Phi(z) + phi(z).
+	// boundary, so count + 1 evaluations of Phi and phi serve all.
 	double zm = (x0 - 0.5) / sigma, Pm, fm;
 	normalCdfPdf(zm, Pm, fm);
 	for (int i = 0; i < count; ++i)
@@ -299,7 +308,7 @@ void pixelSteps(double x0, double sigma, int count, PixelStep* out)
 		const double zp = (x0 + i + 0.5) / sigma;
 		double Pp, fp;
 		normalCdfPdf(zp, Pp, fp);
-		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+		out[i] = stepBetween(sigma, zm, Pm, fm, zp, Pp, fp);
 		zm = zp;
 		Pm = Pp;
 		fm = fp;
@@ -315,7 +324,7 @@ void pixelStepsAt(const double* x, int count, double sigma, PixelStep* out)
 		double Pm, fm, Pp, fp;
 		normalCdfPdf(zm, Pm, fm);
 		normalCdfPdf(zp, Pp, fp);
-		out[i] = {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
+		out[i] = stepBetween(sigma, zm, Pm, fm, zp, Pp, fp);
 	}
 }
 
@@ -431,13 +440,8 @@ std::optional<FillLevel> fitFillLevel(
 	}
 	// Start: least squares on the unclipped samples.
 	Eigen::Vector3d beta = (A + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(bv);
-	double ss = 0;
-	for (int j = 0; j < m; ++j)
-		for (int i = i0; i <= i1; ++i)
-		{
-			const int v = g_profiles[j * n + i];
-			if (v < 255) ss += std::pow(v - level.design(j, i).dot(beta), 2);
-		}
+	// Its residual sum of squares from the sums: sum (v - x.beta)^2.
+	const double ss = std::max(0.0, svv - 2 * beta.dot(bv) + beta.dot(A * beta));
 	const double sigma0 = std::max(0.5, std::sqrt(ss / unclipped));
 	Eigen::Vector4d th;	 // gamma (3), tau
 	th << beta / sigma0, 1 / sigma0;
