@@ -664,8 +664,9 @@ std::string writeResults(
 						const MethodErrors& e = k ? c.general : c.closed_form;
 						// finish() made e.nees the cell's mean.
 						clusters.push_back(
-							small_phi2 ? pose::NeesCluster{e.nees_small_phi2_sum, e.nees_small_phi2_n}
-									   : pose::NeesCluster{e.nees * e.detected, e.detected});
+							small_phi2
+								? pose::NeesCluster{e.nees_small_phi2_sum, e.nees_small_phi2_n}
+								: pose::NeesCluster{e.nees * e.detected, e.detected});
 					}
 					const pose::ClusteredMean m = pose::clusteredMean(clusters, 3);
 					s << (k ? ", gen " : " cf ");

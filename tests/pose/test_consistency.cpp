@@ -59,8 +59,8 @@ TEST(Consistency, MeanNeesInsideTheChiSquareBand)
 TEST(Consistency, StudentTQuantileMatchesTables)
 {
 	// Two-sided 95% points of Student's t (any statistics table).
-	const std::pair<double, double> table[] = {
-		{3, 3.182446}, {5, 2.570582}, {10, 2.228139}, {30, 2.042272}, {55, 2.004045}, {1e6, 1.959966}};
+	const std::pair<double, double> table[] = {{3, 3.182446},  {5, 2.570582},  {10, 2.228139},
+											   {30, 2.042272}, {55, 2.004045}, {1e6, 1.959966}};
 	for (const auto& [nu, t] : table)
 	{
 		EXPECT_NEAR(studentTQuantile(0.975, nu), t, (nu < 10 ? 2e-3 : 5e-5) * t) << nu;

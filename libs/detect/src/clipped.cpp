@@ -291,7 +291,8 @@ namespace
 {
 /** The pixel between the boundaries z_m and z_p (in sigmas, with Phi and
  * phi there): the integral of Phi is z Phi(z) + phi(z). */
-PixelStep stepBetween(double sigma, double zm, double Pm, double fm, double zp, double Pp, double fp)
+PixelStep stepBetween(
+	double sigma, double zm, double Pm, double fm, double zp, double Pp, double fp)
 {
 	return {sigma * (zp * Pp + fp - zm * Pm - fm), Pp - Pm, fp - fm};
 }

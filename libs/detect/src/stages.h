@@ -353,7 +353,7 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
  * spread of neighbouring pixels' differences (0 under about half a grey
  * level, where most differences are 0). Nullopt when the cell is under
  * 3 x 3 px in the image. */
-std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& coarse, double cell_rel);
+std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit
@@ -422,7 +422,7 @@ struct FaceMap
 	Eigen::Vector2d operator()(double x, double y) const
 	{
 		const Eigen::Vector3d q = H * Eigen::Vector3d(x, y, 1);
-		const Eigen::Vector2d ideal = q.head<2>() / q.z();
+		Eigen::Vector2d ideal = q.head<2>() / q.z();
 		if (!distorted) return ideal;
 		return cam.distortNormalized(
 			{(ideal.x() - cam.cx()) / cam.fx(), (ideal.y() - cam.cy()) / cam.fy()});
