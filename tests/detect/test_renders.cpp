@@ -57,6 +57,41 @@ TEST(Renders, Distance0p5To5m)
 	EXPECT_GE(n, 57);
 }
 
+// DetectionQuality::image_noise_grey, which scales C_P's noise-driven part
+// (pose::PoseOptions::reference_noise_grey): the renderer's pixel noise,
+// measured in the black centre cell, across noise, distance and view angle.
+TEST(Renders, ImageNoiseIsMeasured)
+{
+	for (const double noise : {0.0, 1.0, 2.0, 4.0, 6.0})
+	{
+		sim::RenderOptions o = nominalRender();
+		o.noise_sigma = noise;
+		double sum = 0;
+		int n = 0, seed = 11;
+		for (const double d : {0.7, 1.0, 1.4, 2.5})
+			for (const double a : {0.0, 0.6, 1.1})
+			{
+				const Shot s = shoot(7, d, a, o, ++seed);
+				const auto r = run(s.render.image);
+				ASSERT_EQ(r.landmarks.size(), 1u) << noise << " " << d << " " << a;
+				const double m = r.landmarks[0].detection.quality.image_noise_grey;
+				if (a > 1 && d > 0.8 && m == 0) continue;  // at 63 deg the cell is 2.2x narrower
+				if (d > 2)
+				{
+					// The centre cell under 5 x 5 px clear of its sides: not measured.
+					EXPECT_EQ(m, 0) << noise << " " << d << " " << a;
+					continue;
+				}
+				// Each within 20% and 0.3 grey levels (the rounding: up to
+				// sqrt(1 / 12) on a noise-free cell).
+				EXPECT_NEAR(m, noise, 0.2 * noise + 0.3) << noise << " " << d << " " << a;
+				sum += m;
+				++n;
+			}
+		EXPECT_NEAR(sum / n, noise, 0.1 * noise + 0.15) << noise;
+	}
+}
+
 TEST(Renders, ViewAngle0To60Deg)
 {
 	int n = 0;

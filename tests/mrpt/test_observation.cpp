@@ -80,6 +80,7 @@ void expectSame(const CObservationCodedLandmarks& a, const CObservationCodedLand
 		EXPECT_EQ(x.quality.area_px, y.quality.area_px);
 		EXPECT_EQ(x.quality.corner_sigma_px, y.quality.corner_sigma_px);
 		EXPECT_EQ(x.quality.fill_clipped, y.quality.fill_clipped);
+		EXPECT_EQ(x.quality.image_noise_grey, y.quality.image_noise_grey);
 		EXPECT_EQ(x.method, y.method);
 	}
 }
@@ -132,6 +133,22 @@ TEST(CodedLandmarksObs, ClippedSidesRoundTrip)
 		codemark::test::fromBytes(codemark::test::toBytes(o)));
 	ASSERT_TRUE(back);
 	expectSame(o, *back);
+}
+
+TEST(CodedLandmarksObs, ImageNoiseRoundTrip)
+{
+	// Version 2's image noise (the golden file, version 0, reads it as 0,
+	// not measured).
+	auto o = makeFilled();
+	o.sightings[0].quality.image_noise_grey = 2.125;
+	o.sightings[1].quality.image_noise_grey = 5.5;
+	const auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(
+		codemark::test::fromBytes(codemark::test::toBytes(o)));
+	ASSERT_TRUE(back);
+	expectSame(o, *back);
+	// A negative noise is corrupt data, not a measurement.
+	o.sightings[1].quality.image_noise_grey = -1;
+	EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)));
 }
 
 TEST(CodedLandmarksObs, TruncatedBytesThrow)

@@ -638,7 +638,16 @@ std::optional<ChannelFillLevel> fillLevelFromChannels(
 	return out;
 }
 
-std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
+namespace
+{
+/** |G(x + 1, y) - G(x, y)| over the centre cell of \a q, shrunk by
+ * \a margin_px on each side; nullopt when that leaves a half-width under
+ * \a min_half px. \a foreshortened: the window's width and height from
+ * the quadrangle's own (a cell seen obliquely is narrower than tall), else
+ * a square from its mean side. */
+std::optional<std::vector<double>> centreCellDifferences(
+	const cv::Mat& bgr, const Quad& q, double cell_rel, double margin_px, int min_half,
+	bool foreshortened)
 {
 	// The diagonals' intersection.
 	const Eigen::Vector3d d1 =
@@ -650,24 +659,72 @@ std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double 
 	const double cx = c.x() / c.z(), cy = c.y() / c.z();
 	const double side = 0.25 * ((q[1] - q[0]).norm() + (q[2] - q[1]).norm() + (q[3] - q[2]).norm() +
 								(q[0] - q[3]).norm());
-	// Half the cell, less the reach of a blur and of JPEG ringing.
-	const int h = static_cast<int>(std::floor(0.5 * cell_rel * side - 2.5));
-	if (h < 1) return std::nullopt;
-	const int x0 = static_cast<int>(std::lround(cx)) - h,
-			  y0 = static_cast<int>(std::lround(cy)) - h;
-	if (x0 < 0 || y0 < 0 || x0 + 2 * h + 1 >= bgr.cols || y0 + 2 * h >= bgr.rows)
+	const double width = foreshortened
+							 ? 0.5 * (std::abs(q[1].x() - q[0].x()) + std::abs(q[2].x() - q[3].x()))
+							 : side;
+	const double height =
+		foreshortened ? 0.5 * (std::abs(q[3].y() - q[0].y()) + std::abs(q[2].y() - q[1].y()))
+					  : side;
+	const int hx = static_cast<int>(std::floor(0.5 * cell_rel * width - margin_px));
+	const int hy = static_cast<int>(std::floor(0.5 * cell_rel * height - margin_px));
+	if (hx < min_half || hy < min_half) return std::nullopt;
+	const int x0 = static_cast<int>(std::lround(cx)) - hx,
+			  y0 = static_cast<int>(std::lround(cy)) - hy;
+	if (x0 < 0 || y0 < 0 || x0 + 2 * hx + 1 >= bgr.cols || y0 + 2 * hy >= bgr.rows)
 		return std::nullopt;
 	std::vector<double> diffs;
-	for (int y = y0; y <= y0 + 2 * h; ++y)
+	diffs.reserve(size_t(2 * hx + 1) * (2 * hy + 1));
+	for (int y = y0; y <= y0 + 2 * hy; ++y)
 	{
 		const uint8_t* row = bgr.ptr<uint8_t>(y);
-		for (int x = x0; x <= x0 + 2 * h; ++x)
+		for (int x = x0; x <= x0 + 2 * hx; ++x)
 			diffs.push_back(std::abs(double(row[3 * (x + 1) + 1]) - row[3 * x + 1]));
 	}
-	std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
-	// The difference of two samples has sqrt(2) sigma; its median absolute
-	// value is 0.6745 of that.
-	return diffs[diffs.size() / 2] / (0.6745 * std::sqrt(2.0));
+	return diffs;
+}
+
+// The difference of two samples has sqrt(2) sigma; its median absolute value
+// is 0.6745 of that.
+constexpr double kMadToSigma = 1 / (0.6745 * 1.4142135623730951);
+}  // namespace
+
+std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel)
+{
+	// Half the cell, less the reach of a blur and of JPEG ringing.
+	auto diffs = centreCellDifferences(bgr, q, cell_rel, 2.5, 1, false);
+	if (!diffs) return std::nullopt;
+	std::nth_element(diffs->begin(), diffs->begin() + diffs->size() / 2, diffs->end());
+	return (*diffs)[diffs->size() / 2] * kMadToSigma;
+}
+
+std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, double cell_rel)
+{
+	// 3.5 px from the cell's sides: at 2.5 px a 0.8 px blur of the black to
+	// green step (230 grey levels) still slopes by about a grey level a
+	// pixel, which the RMS would count as noise. The window as wide and as
+	// tall as the cell looks (narrower seen obliquely; a square window read
+	// 2.64 for noise 2 over views to 70 deg). At least 5 x 5 pixels: the
+	// estimate is then within about 15% (a cell over about 11 px, a
+	// landmark of the spec's size nearer than about 1.5 m with the paper's
+	// camera; beyond, C_P is the detector's bias more than its noise).
+	auto diffs = centreCellDifferences(bgr, q, cell_rel, 3.5, 2, true);
+	if (!diffs) return std::nullopt;
+	// The median of integer differences is coarse (it reads 1.05 for any
+	// sigma from about 0.8 to 1.3): the RMS of the differences within 4
+	// robust sigmas (one more grey level for the rounding) instead, which a
+	// stray edge pixel does not move and a Gaussian loses 0.1% of.
+	std::vector<double> sorted = *diffs;
+	std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+	const double cut = 4 * std::sqrt(2.0) * sorted[sorted.size() / 2] * kMadToSigma + 1;
+	double ss = 0;
+	int n = 0;
+	for (const double d : *diffs)
+		if (d <= cut)
+		{
+			ss += d * d;
+			++n;
+		}
+	return n > 0 ? std::sqrt(ss / n / 2) : 0.0;
 }
 
 bool imputeClippedSide(

@@ -354,6 +354,11 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
  * level, where most differences are 0). Nullopt when the cell is under
  * 3 x 3 px in the image. */
 std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel);
+/** The same cell's noise as the RMS of the neighbours' differences within 4
+ * robust sigmas, over sqrt(2): not quantised to the grey levels as the
+ * median is (DetectionQuality::image_noise_grey). Farther from the cell's
+ * sides (3.5 px) and over at least 5 x 5 px; nullopt otherwise. */
+std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, double cell_rel);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit

@@ -45,8 +45,9 @@ CObservationCodedLandmarks::TSighting CObservationCodedLandmarks::TSighting::Fro
 	return s;
 }
 
-// Version 1 adds DetectionQuality::fill_clipped (a bit per side).
-uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 1; }
+// Version 1 adds DetectionQuality::fill_clipped (a bit per side), version 2
+// DetectionQuality::image_noise_grey.
+uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 2; }
 
 void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -70,6 +71,7 @@ void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out)
 		uint8_t clipped = 0;
 		for (int k = 0; k < 4; ++k) clipped |= s.quality.fill_clipped[k] ? (1u << k) : 0u;
 		out.WriteAs<uint8_t>(clipped);
+		out << s.quality.image_noise_grey;
 	}
 }
 
@@ -79,6 +81,7 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 	{
 		case 0:
 		case 1:
+		case 2:
 		{
 			in >> timestamp >> sensorLabel >> cameraPose >> camera;
 			const auto n = in.ReadAs<uint32_t>();
@@ -117,6 +120,15 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 							"CObservationCodedLandmarks: corrupt data, clipped-sides mask %u",
 							static_cast<unsigned>(clipped));
 					for (int k = 0; k < 4; ++k) s.quality.fill_clipped[k] = (clipped >> k) & 1u;
+				}
+				if (version >= 2)
+				{
+					in >> s.quality.image_noise_grey;
+					if (!(s.quality.image_noise_grey >= 0) ||
+						!std::isfinite(s.quality.image_noise_grey))
+						THROW_EXCEPTION_FMT(
+							"CObservationCodedLandmarks: corrupt data, image noise %g",
+							s.quality.image_noise_grey);
 				}
 				// A detection never has a non-finite measurement; such a value
 				// would only poison a filter later, far from its cause.

@@ -32,6 +32,11 @@ struct DetectionQuality
 	 * its transition only (restored from an edge model where it fits): it
 	 * is less certain (pose::PoseOptions::clipped_side_sigma_px). */
 	std::array<bool, 4> fill_clipped{{false, false, false, false}};
+	/** The image's noise at the landmark: the standard deviation of G in
+	 * its black centre cell [grey levels] (detect::centreCellNoiseRms());
+	 * 0 when not measured (a cell under 3 x 3 px). pose::PoseOptions::
+	 * reference_noise_grey scales the noise-driven part of C_P with it. */
+	double image_noise_grey = 0;
 };
 
 /** One detected landmark. */
