@@ -361,6 +361,9 @@ TEST(Options, LoadSaveAndMethodNames)
 	o.method = PoseMethod::General6Dof;
 	o.sigma_px = 0.2;
 	o.fold_ambiguity = true;
+	o.reference_noise_grey = 2;
+	o.noise_sigma_x_table = sigmaTableFromString("20:0.01 80:0.004");
+	o.noise_sigma_y_table = sigmaTableFromString("30:0.012");
 	mrpt::config::CConfigFileMemory cfg;
 	o.saveToConfigFile(cfg, "POSE");
 	PoseOptions r;
@@ -368,6 +371,9 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_EQ(r.method, PoseMethod::General6Dof);
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
 	EXPECT_TRUE(r.fold_ambiguity);
+	EXPECT_DOUBLE_EQ(r.reference_noise_grey, 2);
+	EXPECT_EQ(r.noise_sigma_x_table, o.noise_sigma_x_table);
+	EXPECT_EQ(r.noise_sigma_y_table, o.noise_sigma_y_table);
 	cfg.write("POSE", "sigma_px", -1.0);
 	EXPECT_THROW(r.loadFromConfigFile(cfg, "POSE"), std::invalid_argument);
 	// Not numbers at all (MRPT would read 0.03 and 0), not booleans (MRPT's
@@ -376,6 +382,8 @@ TEST(Options, LoadSaveAndMethodNames)
 		{"clipped_side_sigma_px", "0.03px"},
 		{"lm_max_iterations", "0.03px"},
 		{"fold_ambiguity", "maybe"},
+		{"reference_noise_grey", "2 grey"},
+		{"noise_sigma_x_table", "20:0.01 10:0.02"},
 		{"refine_on_primary", "maybe"},
 		{"second_order_pose_covariance", "true ; note"}};
 	for (const auto& [key, value] : bad_values)
@@ -458,6 +466,60 @@ TEST(PrimaryCovariance, SizeDependentModel)
 	// Smaller landmarks are noisier.
 	EXPECT_GT(o.primaryCovariance(P / 2)(0, 0), C(0, 0));
 	o.corr_y12 = 1.0;
+	EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
+// C_P at the image's noise: the noise-driven part of each variance scales
+// with the noise squared, the rest (the detector's bias) stays.
+TEST(PrimaryCovariance, FollowsTheImageNoise)
+{
+	PoseOptions o;
+	o.sigma_x_table = sigmaTableFromString("20:0.05 80:0.01");
+	o.sigma_y_table = sigmaTableFromString("40:0.04 160:0.008");
+	o.corr_growth_x12 = -0.2;
+	o.corr_growth_y12 = 0.3;
+	const Eigen::Vector4d P(-40, 40, 40, 41);  // width 80 px, height 81 px
+	const Eigen::Matrix4d C_ref = o.primaryCovariance(P);
+	// Off (no reference) or no measured noise: unchanged.
+	EXPECT_EQ(o.primaryCovariance(P, 6.0), C_ref);
+	o.reference_noise_grey = 2;
+	o.noise_sigma_x_table = sigmaTableFromString("20:0.03 80:0.006");
+	o.noise_sigma_y_table = sigmaTableFromString("40:0.02 160:0.004");
+	EXPECT_EQ(o.primaryCovariance(P, 0.0), C_ref);
+	EXPECT_LT((o.primaryCovariance(P, 2.0) - C_ref).norm(), 1e-18);
+	const double nx = 0.006 * 0.006, vx = C_ref(0, 0);
+	const double sy = interpolateSigma(o.noise_sigma_y_table, 81), vy = C_ref(1, 1);
+	// A quieter image than the reference keeps its C_P.
+	EXPECT_LT((o.primaryCovariance(P, 1.0) - C_ref).norm(), 1e-18);
+	for (const double n : {3.0, 4.0, 6.0})
+	{
+		const double q = (n / 2) * (n / 2) - 1;
+		const Eigen::Matrix4d C = o.primaryCovariance(P, n);
+		EXPECT_NEAR(C(0, 0), vx + q * nx, 1e-15) << n;
+		EXPECT_NEAR(C(2, 2), vx + q * nx, 1e-15) << n;
+		EXPECT_NEAR(C(1, 1), vy + q * sy * sy, 1e-15) << n;
+		// Each axis's correlation is kept, x and y stay uncorrelated.
+		EXPECT_NEAR(C(0, 2) / C(0, 0), C_ref(0, 2) / C_ref(0, 0), 1e-12) << n;
+		EXPECT_NEAR(C(1, 3) / C(1, 1), C_ref(1, 3) / C_ref(1, 1), 1e-12) << n;
+		EXPECT_EQ(C(0, 1), 0);
+		EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(C).eigenvalues().minCoeff(), 0);
+		// More noise, more variance.
+		EXPECT_GT(o.primaryCovariance(P, n * 1.5)(0, 0), C(0, 0));
+	}
+	// A noise part as large as the whole variance: all of it scales.
+	o.noise_sigma_x_table = sigmaTableFromString("20:1 80:1");
+	EXPECT_NEAR(o.primaryCovariance(P, 4.0)(0, 0), 4 * vx, 1e-15);
+	// measure() of a detection takes the detector's noise.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	Detection d;
+	d.corners = {{{280, 200}, {360, 200}, {360, 281}, {280, 281}}};
+	o.noise_sigma_x_table = sigmaTableFromString("20:0.03 80:0.006");
+	d.quality.image_noise_grey = 2;
+	const double c2 = measure(d, cam, g, o).C_P(0, 0);
+	d.quality.image_noise_grey = 6;
+	EXPECT_GT(measure(d, cam, g, o).C_P(0, 0), c2);
+	o.reference_noise_grey = -1;
 	EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 

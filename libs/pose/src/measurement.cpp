@@ -25,6 +25,25 @@ std::string lower(std::string s)
 }
 }  // namespace
 
+namespace
+{
+/** The table under \a key, or \a current when the key is missing; a bad
+ * table's error names its section and key. */
+SigmaTable readSigmaTable(
+	const mrpt::config::CConfigFileBase& c, const std::string& section, const std::string& key,
+	const SigmaTable& current)
+{
+	try
+	{
+		return sigmaTableFromString(c.read_string(section, key, toString(current)));
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::invalid_argument("[" + section + "] " + key + ": " + e.what());
+	}
+}
+}  // namespace
+
 std::string toString(PoseMethod m)
 {
 	return m == PoseMethod::ClosedForm ? "ClosedForm" : "General6Dof";
@@ -124,7 +143,10 @@ void PoseOptions::validate() const
 		!std::isfinite(corner_midpoint_ratio) || !std::isfinite(corner_tilt_ratio))
 		throw std::invalid_argument(
 			"pose options: corner_midpoint_ratio, corner_tilt_ratio must be finite and > 0");
-	for (const SigmaTable* t : {&sigma_x_table, &sigma_y_table})
+	if (!(reference_noise_grey >= 0) || !std::isfinite(reference_noise_grey))
+		throw std::invalid_argument("pose options: reference_noise_grey must be finite and >= 0");
+	for (const SigmaTable* t :
+		 {&sigma_x_table, &sigma_y_table, &noise_sigma_x_table, &noise_sigma_y_table})
 		for (size_t k = 0; k < t->size(); ++k)
 			if (!((*t)[k].first > 0) || !((*t)[k].second > 0) || !std::isfinite((*t)[k].second) ||
 				(k > 0 && !((*t)[k].first > (*t)[k - 1].first)))
@@ -142,7 +164,8 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 		{"sigma_px", "sigma_y_px", "growth_x_px", "growth_y_px", "size_exponent_x",
 		 "size_exponent_y", "size_reference_px", "corr_x12", "corr_y12", "corr_growth_x12",
 		 "corr_growth_y12", "clipped_side_sigma_px", "clipped_side_correlation",
-		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio", "min_sigma_px"});
+		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio", "min_sigma_px",
+		 "reference_noise_grey"});
 	requireIniNumbers(c, s, {"lm_max_iterations"}, true);
 	requireIniBooleans(
 		c, s, {"second_order_pose_covariance", "refine_on_primary", "fold_ambiguity"});
@@ -152,10 +175,11 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	sigma_source = sigmaSourceFromString(c.read_string(s, "sigma_source", toString(sigma_source)));
 	MRPT_LOAD_CONFIG_VAR(growth_x_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(growth_y_px, double, c, s);
-	sigma_x_table =
-		sigmaTableFromString(c.read_string(s, "sigma_x_table", toString(sigma_x_table)));
-	sigma_y_table =
-		sigmaTableFromString(c.read_string(s, "sigma_y_table", toString(sigma_y_table)));
+	sigma_x_table = readSigmaTable(c, s, "sigma_x_table", sigma_x_table);
+	sigma_y_table = readSigmaTable(c, s, "sigma_y_table", sigma_y_table);
+	MRPT_LOAD_CONFIG_VAR(reference_noise_grey, double, c, s);
+	noise_sigma_x_table = readSigmaTable(c, s, "noise_sigma_x_table", noise_sigma_x_table);
+	noise_sigma_y_table = readSigmaTable(c, s, "noise_sigma_y_table", noise_sigma_y_table);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_x, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_y, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_reference_px, double, c, s);
@@ -199,6 +223,15 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(
 		s, "sigma_y_table", toString(sigma_y_table), -1, -1,
 		"size:sigma pairs [px] of y1, y2 against y1 + y2; replace sigma_y_px and growth_y_px");
+	c.write(
+		s, "reference_noise_grey", reference_noise_grey, -1, -1,
+		"image noise the sigmas were measured at [grey levels]; 0: C_P ignores the image noise");
+	c.write(
+		s, "noise_sigma_x_table", toString(noise_sigma_x_table), -1, -1,
+		"size:sigma pairs [px], the noise-driven part of sigma(x1, x2) at reference_noise_grey");
+	c.write(
+		s, "noise_sigma_y_table", toString(noise_sigma_y_table), -1, -1,
+		"size:sigma pairs [px], the noise-driven part of sigma(y1, y2) at reference_noise_grey");
 	c.write(
 		s, "size_exponent_x", size_exponent_x, -1, -1,
 		"sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
@@ -244,7 +277,20 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 		"General6Dof: LM iterations per refinement");
 }
 
-Eigen::Matrix4d PoseOptions::primaryCovariance(const Eigen::Vector4d& P) const
+double PoseOptions::noiseScale(bool x, double size_px, double var, double image_noise_grey) const
+{
+	const SigmaTable& t = x ? noise_sigma_x_table : noise_sigma_y_table;
+	if (!(reference_noise_grey > 0) || !(image_noise_grey > 0) || t.empty() || !(var > 0)) return 1;
+	// Not below the reference: the calibration does not reach quieter
+	// images, where the detector's error need not fall (on the accuracy
+	// map within 2 m its range error at noise 1 is 1.5x that at noise 2).
+	const double r = std::max(1.0, image_noise_grey / reference_noise_grey);
+	const double share = std::min(1.0, std::pow(interpolateSigma(t, size_px), 2) / var);
+	return std::max(0.0, 1 + (r * r - 1) * share);
+}
+
+Eigen::Matrix4d PoseOptions::primaryCovariance(
+	const Eigen::Vector4d& P, double image_noise_grey) const
 {
 	// Apparent sizes, floored at 1 px so that a degenerate P gives a large
 	// but finite covariance.
@@ -268,6 +314,16 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(const Eigen::Vector4d& P) const
 		C(1, 1) = C(3, 3) = v;
 		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
 	}
+	// Each axis's block scaled as a whole keeps its correlation and stays
+	// positive definite.
+	const double kx = noiseScale(true, w, C(0, 0), image_noise_grey);
+	const double ky = noiseScale(false, h, C(1, 1), image_noise_grey);
+	for (const int i : {0, 2})
+		for (const int j : {0, 2})
+		{
+			C(i, j) *= kx;
+			C(i + 1, j + 1) *= ky;
+		}
 	return C;
 }
 
@@ -309,14 +365,15 @@ namespace
 Measurement measureWith(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options,
-	const std::array<bool, 4>& clipped)
+	const std::array<bool, 4>& clipped, double image_noise_grey)
 {
 	options.validate();
 	Measurement m;
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	m.C_P = options.primaryCovariance(m.P) + options.clippedSidesCovariance(clipped);
+	m.C_P =
+		options.primaryCovariance(m.P, image_noise_grey) + options.clippedSidesCovariance(clipped);
 	if (options.aligned_edge_ratio > 0)
 	{
 		// Rows between the ends of the top (TL, TR) and bottom (BL, BR) edges.
@@ -447,7 +504,7 @@ Measurement measure(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options)
 {
-	return measureWith(corners, camera, geometry, options, {{false, false, false, false}});
+	return measureWith(corners, camera, geometry, options, {{false, false, false, false}}, 0);
 }
 
 Measurement measure(
@@ -464,8 +521,12 @@ Measurement measure(
 		// The tables would override the detector's sigma.
 		o.sigma_x_table.clear();
 		o.sigma_y_table.clear();
+		// The detector's sigma already follows its image's noise.
+		o.reference_noise_grey = 0;
 	}
-	return measureWith(detection.corners, camera, geometry, o, detection.quality.fill_clipped);
+	return measureWith(
+		detection.corners, camera, geometry, o, detection.quality.fill_clipped,
+		detection.quality.image_noise_grey);
 }
 
 }  // namespace codemark::pose

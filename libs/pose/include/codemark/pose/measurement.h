@@ -186,8 +186,37 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * corr_growth_y12 gy^2, gx = growth_x_px (size_reference_px / (x2 - x1))^size_exponent_x, gy =
 	 * growth_y_px (size_reference_px / (y1 + y2))^size_exponent_y, no x-y terms. With the growth
 	 * terms and correlations at 0 this is the spec's C_P = diag(sigma_px^2, sigma_y^2, sigma_px^2,
-	 * sigma_y^2). */
-	Eigen::Matrix4d primaryCovariance(const Eigen::Vector4d& P) const;
+	 * sigma_y^2). With reference_noise_grey > 0 and \a image_noise_grey > 0
+	 * each axis's block is then scaled to the image's noise
+	 * (noiseScale()). */
+	Eigen::Matrix4d primaryCovariance(const Eigen::Vector4d& P, double image_noise_grey = 0) const;
+	/** The noise at which the sigmas above were measured [grey levels], as
+	 * the detector measures it (the mean DetectionQuality::image_noise_grey
+	 * on the calibration renders, so that its estimator's bias cancels).
+	 * When > 0 and the detector reports
+	 * its image's noise n (DetectionQuality::image_noise_grey), the part of
+	 * each variance that grows with the noise (noise_sigma_x_table,
+	 * noise_sigma_y_table, at this noise) is scaled by (n / reference)^2:
+	 * var(s, n) = var(s) + ((n / reference)^2 - 1) noise_sigma(s)^2. The
+	 * rest is the detector's bias at that size, which the noise does not
+	 * change. A quieter image keeps the reference's C_P (n is taken at
+	 * least the reference: below it the detector's error need not fall).
+	 * 0: C_P does not depend on the image (the library default).
+	 * ini key `reference_noise_grey`. */
+	double reference_noise_grey = 0;
+	/** sigma of the noise-driven part of the error of x1, x2 at
+	 * reference_noise_grey against the apparent width x2 - x1
+	 * (codemark-bench-pose-calib --noise-split). ini key
+	 * `noise_sigma_x_table`. */
+	SigmaTable noise_sigma_x_table;
+	/** The same for y1, y2 against y1 + y2. ini key `noise_sigma_y_table`. */
+	SigmaTable noise_sigma_y_table;
+	/** The factor of the variances of the x (\a x true) or y components at
+	 * the image noise \a image_noise_grey, given their variance \a var at
+	 * the reference noise and the apparent size \a size_px: 1 + ((n / ref)^2
+	 * - 1) min(1, noise_sigma(size)^2 / var) with n at least ref; 1 when the
+	 * model is off or the noise unknown (0). */
+	double noiseScale(bool x, double size_px, double var, double image_noise_grey) const;
 	/** ini key `sigma_source` = Fixed | Detector (the latter only through
 	 * measure(const Detection&, ...)). */
 	SigmaSource sigma_source = SigmaSource::Fixed;
@@ -271,7 +300,9 @@ Measurement measure(
 	const LandmarkGeometry& geometry, const PoseOptions& options = PoseOptions());
 
 /** As measure() on \a detection's corners; with SigmaSource::Detector the
- * corner noise is the detector's own estimate (see SigmaSource). */
+ * corner noise is the detector's own estimate (see SigmaSource); with
+ * PoseOptions::reference_noise_grey C_P follows the image noise the
+ * detector measured. */
 Measurement measure(
 	const Detection& detection, const CameraModel& camera, const LandmarkGeometry& geometry,
 	const PoseOptions& options = PoseOptions());
