@@ -53,6 +53,7 @@ struct Sample
 	 * 1 - the rows between their ends (true corners), 0 beyond one row. */
 	double aligned_weight = 0;
 	double rows_top = 0, rows_bottom = 0;  // rows between the top and bottom edges' ends [px]
+	double image_noise = 0;	 // DetectionQuality::image_noise_grey (0: not measured)
 	Eigen::Vector4d P_true = Eigen::Vector4d::Zero();
 	/** Clipped sides on x1, x2 (left, right: 0 or 1) and on y1, y2 (top and bottom: 0-2). */
 	int clippedOn(int component) const
@@ -117,6 +118,12 @@ int main(int argc, char** argv)
 			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> csv_arg(
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
+		TCLAP::ValueArg<double> noise_split_arg(
+			"", "noise-split",
+			"Render the same poses again at this pixel noise [grey levels] and print the part "
+			"of the tabulated sigmas that grows with the noise (PoseOptions::"
+			"reference_noise_grey, noise_sigma_x_table, noise_sigma_y_table). 0: off.",
+			false, 0, "S", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
 		if (n_arg.getValue() < 1 || !(dmin_arg.getValue() > 0) ||
@@ -150,52 +157,61 @@ int main(int argc, char** argv)
 			detector_arg.getValue().empty()
 				? detect::DetectorOptions()
 				: detect::DetectorOptions::load(detector_arg.getValue());
-		std::mt19937_64 rng(seed_arg.getValue());
-		std::uniform_real_distribution<double> U(0, 1);
-		std::vector<Sample> samples;
-		int missed = 0;
-		for (int i = 0; i < n_arg.getValue(); ++i)
+		// The renders at \a r (the same poses and noise seeds for any r).
+		const auto collect = [&](const sim::RenderOptions& r, int& missed)
 		{
-			// Uniform in area over the annulus sector: as the survey grid.
-			const double r0 = dmin_arg.getValue(), r1 = dmax_arg.getValue();
-			const double d = uniform_distance_arg.getValue()
-								 ? r0 + U(rng) * (r1 - r0)
-								 : std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
-			const double a = (2 * U(rng) - 1) * amax_arg.getValue();
-			const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue();
-			double height = (2 * U(rng) - 1) * height_arg.getValue();
-			if (U(rng) < level_arg.getValue()) height = 0;
-			scene.world_T_camera =
-				sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
-			const sim::Render img = sim::render(scene, ro, seed_arg.getValue() * 100003 + i);
-			if (!img.truth[0].fully_visible) continue;
-			const auto res = detect::detect(img.image, scene.camera, g, dopt);
-			bool found = false;
-			for (const auto& dl : res.landmarks)
-				if (dl.detection.id == lm.id)
-				{
-					Sample s;
-					s.d = d;
-					s.angle_deg = a;
-					s.side_px = img.truth[0].P[1] + img.truth[0].P[3];
-					s.width_px = img.truth[0].P[2] - img.truth[0].P[0];
-					for (int k = 0; k < 4; ++k)
-						s.e_corner.segment<2>(2 * k) =
-							dl.detection.corners[k] - img.truth[0].corners_px[k];
-					s.e_P = primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
-					s.clipped = dl.detection.quality.fill_clipped;
-					const auto& tc = img.truth[0].corners_px;
-					s.P_true = img.truth[0].P;
-					s.rows_top = tc[1].y() - tc[0].y();
-					s.rows_bottom = tc[2].y() - tc[3].y();
-					for (const double rows : {tc[1].y() - tc[0].y(), tc[2].y() - tc[3].y()})
-						s.aligned_weight += std::max(0.0, 1 - std::abs(rows));
-					samples.push_back(s);
-					found = true;
-					break;
-				}
-			missed += !found;
-		}
+			std::mt19937_64 rng(seed_arg.getValue());
+			std::uniform_real_distribution<double> U(0, 1);
+			std::vector<Sample> samples;
+			missed = 0;
+			for (int i = 0; i < n_arg.getValue(); ++i)
+			{
+				// Uniform in area over the annulus sector: as the survey grid.
+				const double r0 = dmin_arg.getValue(), r1 = dmax_arg.getValue();
+				const double d = uniform_distance_arg.getValue()
+									 ? r0 + U(rng) * (r1 - r0)
+									 : std::sqrt(r0 * r0 + U(rng) * (r1 * r1 - r0 * r0));
+				const double a = (2 * U(rng) - 1) * amax_arg.getValue();
+				const double bearing = (2 * U(rng) - 1) * bearing_arg.getValue();
+				double height = (2 * U(rng) - 1) * height_arg.getValue();
+				if (U(rng) < level_arg.getValue()) height = 0;
+				scene.world_T_camera =
+					sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
+				const sim::Render img = sim::render(scene, r, seed_arg.getValue() * 100003 + i);
+				if (!img.truth[0].fully_visible) continue;
+				const auto res = detect::detect(img.image, scene.camera, g, dopt);
+				bool found = false;
+				for (const auto& dl : res.landmarks)
+					if (dl.detection.id == lm.id)
+					{
+						Sample s;
+						s.d = d;
+						s.angle_deg = a;
+						s.side_px = img.truth[0].P[1] + img.truth[0].P[3];
+						s.width_px = img.truth[0].P[2] - img.truth[0].P[0];
+						for (int k = 0; k < 4; ++k)
+							s.e_corner.segment<2>(2 * k) =
+								dl.detection.corners[k] - img.truth[0].corners_px[k];
+						s.e_P =
+							primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
+						s.clipped = dl.detection.quality.fill_clipped;
+						s.image_noise = dl.detection.quality.image_noise_grey;
+						const auto& tc = img.truth[0].corners_px;
+						s.P_true = img.truth[0].P;
+						s.rows_top = tc[1].y() - tc[0].y();
+						s.rows_bottom = tc[2].y() - tc[3].y();
+						for (const double rows : {tc[1].y() - tc[0].y(), tc[2].y() - tc[3].y()})
+							s.aligned_weight += std::max(0.0, 1 - std::abs(rows));
+						samples.push_back(s);
+						found = true;
+						break;
+					}
+				missed += !found;
+			}
+			return samples;
+		};
+		int missed = 0;
+		const std::vector<Sample> samples = collect(ro, missed);
 		if (!csv_arg.getValue().empty())
 		{
 			std::ofstream f(csv_arg.getValue());
@@ -519,6 +535,93 @@ int main(int argc, char** argv)
 			std::printf(
 				"  aligned_edge_ratio %.1f (%d detections with a top or bottom edge along a row)\n",
 				k_aligned, n_aligned);
+			if (noise_split_arg.getValue() > 0)
+			{
+				sim::RenderOptions r2 = ro;
+				r2.noise_sigma = noise_split_arg.getValue();
+				if (!(ro.noise_sigma > 0) || r2.noise_sigma == ro.noise_sigma)
+					throw std::invalid_argument(
+						"--noise-split needs renders with noise and a different second noise");
+				int missed2 = 0;
+				const std::vector<Sample> second = collect(r2, missed2);
+				// The noise as the detector measures it (its estimator's own
+				// bias then cancels): the reference is the mean measured on
+				// the calibration renders, the ratio that of the two passes.
+				const auto meanNoise = [](const std::vector<Sample>& v)
+				{
+					double sum = 0;
+					int n = 0;
+					for (const Sample& sm : v)
+						if (sm.image_noise > 0)
+						{
+							sum += sm.image_noise;
+							++n;
+						}
+					return n >= 20 ? sum / n : 0.0;
+				};
+				const double ref_measured = meanNoise(samples), second_measured = meanNoise(second);
+				if (!(ref_measured > 0) || !(second_measured > ref_measured))
+					throw std::runtime_error(
+						"--noise-split: the detector measured the noise on too few renders (its "
+						"centre cell needs about 11 px)");
+				const double q = std::pow(second_measured / ref_measured, 2);
+				// Per entry of the table: the mean square of the unclipped
+				// components whose size is nearest it (in log size), at both
+				// noises; the noise-driven variance at the reference is their
+				// difference over q - 1 (the bias part is common to both).
+				const auto split = [&](bool x, const pose::SigmaTable& t)
+				{
+					std::vector<double> size, var;
+					for (size_t k = 0; k < t.size(); ++k)
+					{
+						const double lo = k ? std::sqrt(t[k - 1].first * t[k].first) : 0;
+						const double hi =
+							k + 1 < t.size() ? std::sqrt(t[k].first * t[k + 1].first) : 1e300;
+						double ms[2] = {0, 0};
+						int n[2] = {0, 0};
+						for (int pass = 0; pass < 2; ++pass)
+							for (const Sample& sm : pass ? second : samples)
+							{
+								const double size = sizeOf(sm, x);
+								if (size < lo || size >= hi) continue;
+								for (const int c : {x ? 0 : 1, x ? 2 : 3})
+									if (sm.clippedOn(c) == 0)
+									{
+										ms[pass] += sm.e_P[c] * sm.e_P[c];
+										++n[pass];
+									}
+							}
+						if (n[0] < 40 || n[1] < 40) continue;
+						size.push_back(t[k].first);
+						var.push_back((ms[1] / n[1] - ms[0] / n[0]) / (q - 1));
+					}
+					// Where the error did not grow (the noise dithers part of a
+					// pixel-phase bias away, as much as it adds), 1e-4 px: a
+					// table's sigmas must be > 0.
+					// Each bin's difference of two mean squares is noisy (a few
+					// hundred samples of a bias-dominated error): averaged with
+					// its neighbours' (three bins, two at the ends).
+					pose::SigmaTable out;
+					for (size_t k = 0; k < var.size(); ++k)
+					{
+						const size_t a = k ? k - 1 : 0, b = std::min(var.size() - 1, k + 1);
+						double mean = 0;
+						for (size_t i = a; i <= b; ++i) mean += var[i] / double(b - a + 1);
+						const double sn = std::sqrt(std::max(mean, 1e-8));
+						const double p10 = std::pow(10, std::floor(std::log10(sn)) - 2);
+						out.emplace_back(size[k], std::round(sn / p10) * p10);
+					}
+					return out;
+				};
+				std::printf(
+					"noise split (%zu detections again at noise %.2f, %d missed; the detector "
+					"measured %.3f and %.3f):\n"
+					"  reference_noise_grey = %.2f\n  noise_sigma_x_table = %s\n"
+					"  noise_sigma_y_table = %s\n",
+					second.size(), r2.noise_sigma, missed2, ref_measured, second_measured,
+					ref_measured, pose::toString(split(true, tx)).c_str(),
+					pose::toString(split(false, ty)).c_str());
+			}
 			// The clipped sides' sigma again and the correlation of their
 			// shifts, by maximum likelihood of all of P under the pose
 			// library's own C_P with the tables above.
