@@ -5,7 +5,7 @@
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,
 # general 6-DoF path and AprilTag 3), writing
 # apps/codemark-accuracy-map/results/ and copying the heat maps to
-# docs/images/. About 10 minutes on 2 cores; `--quick` runs a small map into
+# docs/images/. About 15 minutes on 2 cores; `--quick` runs a small map into
 # a scratch folder instead.
 #
 # Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
@@ -31,11 +31,11 @@ if [[ $quick -eq 1 ]]; then
   exit 0
 fi
 echo "== C_P calibration (realistic scenes, the shipped values: clipped and unclipped sides averaged)"
-"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 60 --uniform-distance --averaged
+"$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 60 --uniform-distance --averaged --noise-split 4
 echo "== C_P calibration (realistic scenes, clipped sides apart)"
 "$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance
 echo "== C_P calibration (the accuracy map's flat background: its C_P, plainBackgroundPoseOptions)"
-"$calib" --renders 3000 --seed 7 --uniform-distance
+"$calib" --renders 3000 --seed 7 --uniform-distance --noise-split 4
 echo "== accuracy map"
 "$map" --out apps/codemark-accuracy-map/results --renders 10
 echo "== accuracy map with the shipped C_P of the textured, lit scenes (for comparison)"
