@@ -524,6 +524,10 @@ std::string writeResults(
 	{
 		std::string name;
 		double dmin, dmax, amax;
+		bool holds(const CellResult& c) const
+		{
+			return c.distance_m > dmin && c.distance_m <= dmax && c.angle_deg <= amax;
+		}
 	};
 	const std::vector<Region> regions{
 		{"within 2 m, all angles", 0, 2.0 + 1e-9, 90},
@@ -566,8 +570,7 @@ std::string writeResults(
 			int cells_total = 0, detected[3] = {0, 0, 0}, renders = 0;
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
-					continue;
+				if (!r.holds(c)) continue;
 				++cells_total;
 				renders += c.renders;
 				const MethodErrors* e[3] = {&c.closed_form, &c.general, &c.apriltag};
@@ -622,24 +625,33 @@ std::string writeResults(
 			"mean NEES of L", [](const MethodErrors& e, const CellResult&) { return e.nees_L; }, {},
 			1, 2);
 		{
+			// Each cell's NEES sum and count in the region, path k (1: the
+			// general one), over its sightings whose reported phi2 sigma is
+			// at most 2 deg or over all.
+			const auto clustersOf = [&](int k, bool small_phi2)
+			{
+				std::vector<pose::NeesCluster> clusters;
+				for (const auto& c : cells)
+				{
+					if (!r.holds(c)) continue;
+					const MethodErrors& e = k ? c.general : c.closed_form;
+					// finish() made e.nees the cell's mean.
+					clusters.push_back(
+						small_phi2 ? pose::NeesCluster{e.nees_small_phi2_sum, e.nees_small_phi2_n}
+								   : pose::NeesCluster{e.nees * e.detected, e.detected});
+				}
+				return clusters;
+			};
 			// Pose NEES pooled over the sightings whose reported phi2 sigma
 			// is at most 2 deg, with its own 95% band.
 			s << "pose NEES where sigma(phi2) <= 2 deg:";
 			for (int k = 0; k < 2; ++k)
 			{
-				double sum = 0;
-				int n = 0;
-				for (const auto& c : cells)
-				{
-					if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
-						continue;
-					const MethodErrors& e = k ? c.general : c.closed_form;
-					sum += e.nees_small_phi2_sum;
-					n += e.nees_small_phi2_n;
-				}
+				const pose::ClusteredMean m = pose::clusteredMean(clustersOf(k, true), 3);
+				const int n = m.count;
 				s << (k ? "; gen " : " cf ");
 				if (n)
-					s << fmt(sum / n, 2) << " over " << n << " ["
+					s << fmt(m.mean, 2) << " over " << n << " ["
 					  << fmt(chi2Quantile(0.025, 3.0 * n) / n, 2) << ", "
 					  << fmt(chi2Quantile(0.975, 3.0 * n) / n, 2) << "]";
 				else
@@ -656,19 +668,7 @@ std::string writeResults(
 				s << (small_phi2 ? "; where sigma(phi2) <= 2 deg" : " all");
 				for (int k = 0; k < 2; ++k)
 				{
-					std::vector<pose::NeesCluster> clusters;
-					for (const auto& c : cells)
-					{
-						if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
-							continue;
-						const MethodErrors& e = k ? c.general : c.closed_form;
-						// finish() made e.nees the cell's mean.
-						clusters.push_back(
-							small_phi2
-								? pose::NeesCluster{e.nees_small_phi2_sum, e.nees_small_phi2_n}
-								: pose::NeesCluster{e.nees * e.detected, e.detected});
-					}
-					const pose::ClusteredMean m = pose::clusteredMean(clusters, 3);
+					const pose::ClusteredMean m = pose::clusteredMean(clustersOf(k, small_phi2), 3);
 					s << (k ? ", gen " : " cf ");
 					if (m.clusters >= 2)
 						s << fmt(m.mean, 2) << " [" << fmt(m.low, 2) << ", " << fmt(m.high, 2)
@@ -688,8 +688,7 @@ std::string writeResults(
 			int n[2] = {0, 0};
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
-					continue;
+				if (!r.holds(c)) continue;
 				const MethodErrors* e[2] = {&c.closed_form, &c.general};
 				for (int k = 0; k < 2; ++k)
 					if (e[k]->detected)
@@ -710,8 +709,7 @@ std::string writeResults(
 			int n = 0, tn = 0;
 			for (const auto& c : cells)
 			{
-				if (c.distance_m <= r.dmin || c.distance_m > r.dmax || c.angle_deg > r.amax)
-					continue;
+				if (!r.holds(c)) continue;
 				if (c.closed_form.detected)
 				{
 					dx += c.corner_dx_px;

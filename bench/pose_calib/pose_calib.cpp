@@ -595,12 +595,12 @@ int main(int argc, char** argv)
 						size.push_back(t[k].first);
 						var.push_back((ms[1] / n[1] - ms[0] / n[0]) / (q - 1));
 					}
-					// Where the error did not grow (the noise dithers part of a
-					// pixel-phase bias away, as much as it adds), 1e-4 px: a
-					// table's sigmas must be > 0.
 					// Each bin's difference of two mean squares is noisy (a few
 					// hundred samples of a bias-dominated error): averaged with
-					// its neighbours' (three bins, two at the ends).
+					// its neighbours' (three bins, two at the ends). Where the
+					// error did not grow (the noise dithers part of a
+					// pixel-phase bias away, as much as it adds), 1e-4 px: a
+					// table's sigmas must be > 0.
 					pose::SigmaTable out;
 					for (size_t k = 0; k < var.size(); ++k)
 					{

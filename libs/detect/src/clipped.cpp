@@ -713,9 +713,9 @@ std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, doub
 	// sigma from about 0.8 to 1.3): the RMS of the differences within 4
 	// robust sigmas (one more grey level for the rounding) instead, which a
 	// stray edge pixel does not move and a Gaussian loses 0.1% of.
-	std::vector<double> sorted = *diffs;
-	std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-	const double cut = 4 * std::sqrt(2.0) * sorted[sorted.size() / 2] * kMadToSigma + 1;
+	// (The RMS below does not care about the order nth_element leaves.)
+	std::nth_element(diffs->begin(), diffs->begin() + diffs->size() / 2, diffs->end());
+	const double cut = 4 * std::sqrt(2.0) * (*diffs)[diffs->size() / 2] * kMadToSigma + 1;
 	double ss = 0;
 	int n = 0;
 	for (const double d : *diffs)

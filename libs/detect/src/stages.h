@@ -354,6 +354,10 @@ void imputeFillLevel(std::vector<int>& g_profiles, int n, const FillLevel& level
  * level, where most differences are 0). Nullopt when the cell is under
  * 3 x 3 px in the image. */
 std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double cell_rel);
+/** A code cell's side over the inner square's (centreCellNoise()'s
+ * cell_rel): the code board fills what the green band of \a fill_ratio
+ * leaves, in three cells. */
+inline double codeCellRatio(double fill_ratio) { return (1 - 2 * fill_ratio) / 3; }
 /** The same cell's noise as the RMS of the neighbours' differences within 4
  * robust sigmas, over sqrt(2): not quantised to the grey levels as the
  * median is (DetectionQuality::image_noise_grey). Farther from the cell's

@@ -536,7 +536,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 	std::optional<double> noise;
 	const auto sensorNoise = [&]
 	{
-		if (!noise_read) noise = centreCellNoise(bgr, coarse, (1 - 2 * fill_ratio) / 3);
+		if (!noise_read) noise = centreCellNoise(bgr, coarse, codeCellRatio(fill_ratio));
 		noise_read = true;
 		return noise;
 	};

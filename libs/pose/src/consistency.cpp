@@ -38,9 +38,9 @@ ClusteredMean clusteredMean(const std::vector<NeesCluster>& clusters, int dof, d
 	r.mean = sum / r.count;
 	if (r.clusters < 2)
 	{
-		r.standard_error = r.low = r.high = r.design_effect =
-			std::numeric_limits<double>::infinity();
-		r.low = -r.low;
+		const double inf = std::numeric_limits<double>::infinity();
+		r.standard_error = r.high = r.design_effect = inf;
+		r.low = -inf;
 		return r;
 	}
 	// Linearised variance of the ratio sum / count over clusters drawn

@@ -23,10 +23,7 @@ std::string lower(std::string s)
 	std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
 	return s;
 }
-}  // namespace
 
-namespace
-{
 /** The table under \a key, or \a current when the key is missing; a bad
  * table's error names its section and key. */
 SigmaTable readSigmaTable(
@@ -286,7 +283,7 @@ double PoseOptions::noiseScale(bool x, double size_px, double var, double image_
 	// map within 2 m its range error at noise 1 is 1.5x that at noise 2).
 	const double r = std::max(1.0, image_noise_grey / reference_noise_grey);
 	const double share = std::min(1.0, std::pow(interpolateSigma(t, size_px), 2) / var);
-	return std::max(0.0, 1 + (r * r - 1) * share);
+	return 1 + (r * r - 1) * share;
 }
 
 Eigen::Matrix4d PoseOptions::primaryCovariance(

@@ -34,7 +34,8 @@ struct DetectionQuality
 	std::array<bool, 4> fill_clipped{{false, false, false, false}};
 	/** The image's noise at the landmark: the standard deviation of G in
 	 * its black centre cell [grey levels] (detect::centreCellNoiseRms());
-	 * 0 when not measured (a cell under 3 x 3 px). pose::PoseOptions::
+	 * 0 when not measured (under 5 x 5 px of the cell 3.5 px clear of its
+	 * sides: beyond about 1.5-2 m with the paper's camera). pose::PoseOptions::
 	 * reference_noise_grey scales the noise-driven part of C_P with it. */
 	double image_noise_grey = 0;
 };
