@@ -130,10 +130,11 @@ int main(int argc, char** argv)
 			!(dmax_arg.getValue() > dmin_arg.getValue()) || !(amax_arg.getValue() >= 0) ||
 			!(amax_arg.getValue() < 90) || !(bearing_arg.getValue() >= 0) ||
 			!(height_arg.getValue() >= 0) || !(level_arg.getValue() >= 0) ||
-			!(level_arg.getValue() <= 1))
+			!(level_arg.getValue() <= 1) || !(noise_split_arg.getValue() >= 0))
 			throw std::invalid_argument(
 				"expected --renders >= 1, 0 < --min-distance < --max-distance, --max-angle in "
-				"[0, 90), --max-bearing and --max-height >= 0, --level-fraction in [0, 1]");
+				"[0, 90), --max-bearing and --max-height >= 0, --level-fraction in [0, 1], "
+				"--noise-split >= 0");
 
 		sim::Scene scene = sim::singleLandmarkScene();
 		const MapLandmark& lm = scene.map.landmarks[0];

@@ -885,6 +885,48 @@ TEST(Code, AmbiguousCellIsRejected)
 	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
 }
 
+// ------------------------------------------------------------------ noise
+
+// surroundNoiseRms(): the noise of the flat blocks around a quadrangle,
+// with most of its window covered by edges and clipped pixels.
+TEST(Noise, SurroundIsTheFlatBlocksNoise)
+{
+	const Quad q{{{100, 100}, {130, 100}, {130, 130}, {100, 130}}};	// 30 px: a 90 px window
+	for (const double sigma : {1.0, 2.0, 5.0})
+	{
+		std::mt19937 rng(7);
+		std::normal_distribution<double> n01;
+		cv::Mat img(240, 240, CV_8UC3);
+		for (int y = 0; y < img.rows; ++y)
+			for (int x = 0; x < img.cols; ++x)
+			{
+				// A horizontal shading (cancels in each block), stripes 5 px
+				// wide over the left half (edges in every block there), and a
+				// clipped band.
+				double g = 60 + 0.5 * x;
+				if (x < 115 && (x / 5) % 2) g += 120;
+				if (y >= 120 && y < 150) g = 300;
+				const double v = std::clamp(std::round(g + sigma * n01(rng)), 0.0, 255.0);
+				img.at<cv::Vec3b>(y, x) = cv::Vec3b(0, uint8_t(v), 0);
+			}
+		const auto m = surroundNoiseRms(img, q);
+		ASSERT_TRUE(m) << sigma;
+		// Within 10% and the rounding (1 / 12 in variance).
+		EXPECT_NEAR(*m, std::sqrt(sigma * sigma + 1.0 / 12), 0.1 * sigma) << sigma;
+	}
+	// All of the window clipped, or edges everywhere: nothing to measure
+	// (or an overestimate, never an underestimate).
+	cv::Mat clipped(240, 240, CV_8UC3, cv::Scalar(0, 255, 0));
+	EXPECT_FALSE(surroundNoiseRms(clipped, q));
+	cv::Mat stripes(240, 240, CV_8UC3, cv::Scalar(0, 60, 0));
+	for (int x = 0; x < stripes.cols; x += 2) stripes.col(x).setTo(cv::Scalar(0, 180, 0));
+	const auto m = surroundNoiseRms(stripes, q);
+	EXPECT_TRUE(!m || *m > 10);
+	// A window off the image: nothing.
+	const Quad outside{{{-300, -300}, {-270, -300}, {-270, -270}, {-300, -270}}};
+	EXPECT_FALSE(surroundNoiseRms(cv::Mat(240, 240, CV_8UC3, cv::Scalar(0, 128, 0)), outside));
+}
+
 // --------------------------------------------------------------- detect()
 
 TEST(Detect, CraftedLandmarkEndToEnd)

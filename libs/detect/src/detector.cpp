@@ -113,7 +113,7 @@ DetectionResult detect(
 		qual.corner_sigma_px = std::sqrt(var_end / 4);
 		qual.fill_clipped = refined->fill_clipped;
 		qual.image_noise_grey =
-			centreCellNoiseRms(bgr, refined->corners_raw, codeCellRatio(fill_ratio)).value_or(0);
+			landmarkNoiseRms(bgr, refined->corners_raw, codeCellRatio(fill_ratio));
 		qual.code_margin = code->margin;
 		const auto& c = refined->corners_ideal;
 		double area2 = 0;

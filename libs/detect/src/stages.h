@@ -363,6 +363,16 @@ inline double codeCellRatio(double fill_ratio) { return (1 - 2 * fill_ratio) / 3
  * median is (DetectionQuality::image_noise_grey). Farther from the cell's
  * sides (3.5 px) and over at least 5 x 5 px; nullopt otherwise. */
 std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, double cell_rel);
+/** The noise of G [grey levels] in flat 8 x 8 px blocks of a window three
+ * times the size of the quadrangle \a q around it (at least 64 px, within
+ * the image; blocks with a clipped pixel left out): the mean over the
+ * blocks without edge or texture of their horizontal differences' variance
+ * about its mean, over 2. Nullopt under 8 such blocks. For a landmark whose
+ * centre cell is too small for centreCellNoiseRms(). */
+std::optional<double> surroundNoiseRms(const cv::Mat& bgr, const Quad& q);
+/** DetectionQuality::image_noise_grey: centreCellNoiseRms() where the cell
+ * is large enough, else surroundNoiseRms(); 0 when neither can tell. */
+double landmarkNoiseRms(const cv::Mat& bgr, const Quad& q, double cell_rel);
 
 /** A straight line n . x + c = 0 (|n| = 1) fitted by total least squares. */
 struct LineFit

@@ -32,11 +32,14 @@ struct DetectionQuality
 	 * its transition only (restored from an edge model where it fits): it
 	 * is less certain (pose::PoseOptions::clipped_side_sigma_px). */
 	std::array<bool, 4> fill_clipped{{false, false, false, false}};
-	/** The image's noise at the landmark: the standard deviation of G in
-	 * its black centre cell [grey levels] (detect::centreCellNoiseRms());
-	 * 0 when not measured (under 5 x 5 px of the cell 3.5 px clear of its
-	 * sides: beyond about 1.5-2 m with the paper's camera). pose::PoseOptions::
-	 * reference_noise_grey scales the noise-driven part of C_P with it. */
+	/** The image's noise at the landmark: the standard deviation of G
+	 * [grey levels] in its black centre cell (detect::centreCellNoiseRms(),
+	 * where at least 5 x 5 px of the cell lie 3.5 px clear of its sides:
+	 * nearer than about 1.5-2 m with the paper's camera), else in the flat
+	 * unclipped 8 x 8 px blocks of a window three times the landmark's size
+	 * around it (detect::surroundNoiseRms()); 0 when not measured (fewer
+	 * than 8 such blocks). pose::PoseOptions::reference_noise_grey scales
+	 * the noise-driven part of C_P with it. */
 	double image_noise_grey = 0;
 };
 
