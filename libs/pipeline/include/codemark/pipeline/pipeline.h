@@ -99,11 +99,11 @@ constexpr double kDetectorCornerTiltRatio = 0.34;  //!< see kDetectorCornerMidpo
  * neighbouring size bins (2026-12-02, 1029 detections). The rest is the
  * detector's bias at that size, which the noise does not change. With it
  * C_P follows the noise the detector measures at each landmark
- * (DetectionQuality::image_noise_grey, where the centre cell is large
- * enough: within about 1.5-2 m with the paper's camera). On the accuracy
- * map (its own calibration, plainBackgroundPoseOptions()) within 2 m the
- * closed form's mean NEES at noise 1 / 2 / 4 / 6 reads 4.14 / 3.34 / 4.00 /
- * 5.41 with it and 4.14 / 3.44 / 8.08 / 16.1 without
+ * (DetectionQuality::image_noise_grey: in its centre cell within about
+ * 1.5-2 m with the paper's camera, in flat blocks around it beyond). On
+ * the accuracy map (its own calibration, plainBackgroundPoseOptions())
+ * within 2 m the closed form's mean NEES at noise 1 / 2 / 4 / 6 reads
+ * 4.14 / 3.33 / 3.40 / 3.76 with it and 4.14 / 3.44 / 8.08 / 16.1 without
  * (docs/benchmarks/pose.md). */
 constexpr const char* kDetectorNoiseSigmaXTable =
 	"13.9:0.00413 18.2:0.00557 22.3:0.00884 27.5:0.00664 34.5:0.0051 42.9:0.00347 "
