@@ -563,11 +563,11 @@ int main(int argc, char** argv)
 				const double ref_measured = meanNoise(samples), second_measured = meanNoise(second);
 				if (!(ref_measured > 0) || !(second_measured > ref_measured))
 					throw std::runtime_error(
-						"--noise-split: the detector measured the noise on too few renders (its "
-						"centre cell needs about 11 px)");
+						"--noise-split: the detector measured the noise on too few renders (under "
+						"20, or no more at the second noise than at the first)");
 				const double q = std::pow(second_measured / ref_measured, 2);
 				// Per entry of the table: the mean square of the unclipped
-				// components whose size is nearest it (in log size), at both
+				// components (all with --averaged) whose size is nearest it (in log size), at both
 				// noises; the noise-driven variance at the reference is their
 				// difference over q - 1 (the bias part is common to both).
 				const auto split = [&](bool x, const pose::SigmaTable& t)
@@ -586,7 +586,11 @@ int main(int argc, char** argv)
 								const double size = sizeOf(sm, x);
 								if (size < lo || size >= hi) continue;
 								for (const int c : {x ? 0 : 1, x ? 2 : 3})
-									if (sm.clippedOn(c) == 0)
+									// With --averaged the tables hold clipped sides
+									// too, and so must their noise-driven part (a
+									// clipped side's edge rests on its dark half and
+									// gains more from the noise).
+									if (sm.clippedOn(c) == 0 || averaged_arg.getValue())
 									{
 										ms[pass] += sm.e_P[c] * sm.e_P[c];
 										++n[pass];
@@ -614,14 +618,87 @@ int main(int argc, char** argv)
 					}
 					return out;
 				};
+				const pose::SigmaTable nx = split(true, tx), ny = split(false, ty);
 				std::printf(
 					"noise split (%zu detections again at noise %.2f, %d missed; the detector "
 					"measured %.3f and %.3f):\n"
 					"  reference_noise_grey = %.2f\n  noise_sigma_x_table = %s\n"
 					"  noise_sigma_y_table = %s\n",
 					second.size(), r2.noise_sigma, missed2, ref_measured, second_measured,
-					ref_measured, pose::toString(split(true, tx)).c_str(),
-					pose::toString(split(false, ty)).c_str());
+					ref_measured, pose::toString(nx).c_str(), pose::toString(ny).c_str());
+				// The second pass against the C_P that the split gives at each
+				// landmark's measured noise (PoseOptions::noiseScale()): the
+				// normalised variances and the general path's corner ratios
+				// there, which the noise scaling assumes unchanged.
+				if (!nx.empty() && !ny.empty())
+				{
+					const auto var2 = [&](const Sample& sm, int c)
+					{
+						const bool x = c % 2 == 0;
+						const double r =
+							sm.image_noise > 0 ? std::max(1.0, sm.image_noise / ref_measured) : 1.0;
+						const double v = var(sm, c);
+						const double ns2 =
+							std::pow(pose::interpolateSigma(x ? nx : ny, sizeOf(sm, x)), 2);
+						return v * (1 + (r * r - 1) * std::min(1.0, ns2 / v));
+					};
+					double zx2 = 0, zy2 = 0, zm = 0, zt = 0;
+					for (const Sample& sm : second)
+					{
+						zx2 += (sm.e_P[0] * sm.e_P[0] / var2(sm, 0) +
+								sm.e_P[2] * sm.e_P[2] / var2(sm, 2)) / 2;
+						zy2 += (sm.e_P[1] * sm.e_P[1] / var2(sm, 1) +
+								sm.e_P[3] * sm.e_P[3] / var2(sm, 3)) / 2;
+						const auto& e = sm.e_corner;
+						const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
+						const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
+						zm += (m1 * m1 / var2(sm, 1) + m2 * m2 / var2(sm, 3)) / 2;
+						zt += (t1 * t1 / var2(sm, 0) + t2 * t2 / var2(sm, 2)) / 2;
+					}
+					const double n2 = second.size();
+					std::printf(
+						"  at noise %.2f with the split: normalised variance x %.3f y %.3f; "
+						"corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n",
+						r2.noise_sigma, zx2 / n2, zy2 / n2, std::sqrt(zm / n2), std::sqrt(zt / n2));
+					// An edge's tilt gains more from the noise than its position
+					// (a line fit's end points: the slope's share is 3x the
+					// offset's), and less from the detector's bias (whole lines
+					// shift): the ratio of its noise-driven part to x's
+					// (PoseOptions::corner_tilt_noise_ratio) that makes its
+					// normalised variance 1 at the second noise, by bisection.
+					const double tilt = std::sqrt(zt2 / n);
+					const auto tiltZ = [&](double k)
+					{
+						double z = 0;
+						for (const Sample& sm : second)
+						{
+							const auto& e = sm.e_corner;
+							const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
+							const auto v = [&](int c)
+							{
+								return tilt * tilt * var(sm, c) +
+									   k * k * (var2(sm, c) - var(sm, c));
+							};
+							z += (t1 * t1 / v(0) + t2 * t2 / v(2)) / 2;
+						}
+						return z / n2;
+					};
+					double lo = 0, hi = 10;
+					if (tiltZ(lo) > 1 && tiltZ(hi) < 1)
+					{
+						for (int it = 0; it < 50; ++it)
+						{
+							const double mid = 0.5 * (lo + hi);
+							(tiltZ(mid) > 1 ? lo : hi) = mid;
+						}
+						std::printf("  corner_tilt_noise_ratio = %.2f\n", 0.5 * (lo + hi));
+					}
+					else
+						std::printf(
+							"  corner_tilt_noise_ratio: none fits (the tilt's normalised variance "
+							"%.2f with none, %.2f at 10)\n",
+							tiltZ(lo), tiltZ(hi));
+				}
 			}
 			// The clipped sides' sigma again and the correlation of their
 			// shifts, by maximum likelihood of all of P under the pose

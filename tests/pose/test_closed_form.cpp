@@ -362,6 +362,7 @@ TEST(Options, LoadSaveAndMethodNames)
 	o.sigma_px = 0.2;
 	o.fold_ambiguity = true;
 	o.reference_noise_grey = 2;
+	o.corner_tilt_noise_ratio = 1.4;
 	o.noise_sigma_x_table = sigmaTableFromString("20:0.01 80:0.004");
 	o.noise_sigma_y_table = sigmaTableFromString("30:0.012");
 	mrpt::config::CConfigFileMemory cfg;
@@ -372,6 +373,7 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
 	EXPECT_TRUE(r.fold_ambiguity);
 	EXPECT_DOUBLE_EQ(r.reference_noise_grey, 2);
+	EXPECT_DOUBLE_EQ(r.corner_tilt_noise_ratio, 1.4);
 	EXPECT_EQ(r.noise_sigma_x_table, o.noise_sigma_x_table);
 	EXPECT_EQ(r.noise_sigma_y_table, o.noise_sigma_y_table);
 	cfg.write("POSE", "sigma_px", -1.0);
@@ -383,6 +385,7 @@ TEST(Options, LoadSaveAndMethodNames)
 		{"lm_max_iterations", "0.03px"},
 		{"fold_ambiguity", "maybe"},
 		{"reference_noise_grey", "2 grey"},
+		{"corner_tilt_noise_ratio", "1.4x"},
 		{"noise_sigma_x_table", "20:0.01 10:0.02"},
 		{"refine_on_primary", "maybe"},
 		{"second_order_pose_covariance", "true ; note"}};

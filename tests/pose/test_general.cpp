@@ -313,6 +313,73 @@ TEST(General, CornerCovarianceFromPrimaryReproducesCP)
 	}
 }
 
+// corner_tilt_noise_ratio: the extra tilt variance lands on the tilts alone
+// (P's covariance and the midpoints' unchanged), and measure() adds it only
+// for an image noisier than the reference.
+TEST(General, TiltTakesItsOwnShareOfTheNoise)
+{
+	const CameraModel cam;	// no distortion: the tilts are the corners' x
+	const LandmarkGeometry g;
+	const auto corners = projectCorners(cameraAt(1.5, 0.4, 0.1, 0.05), cam, g);
+	Eigen::Matrix4d C_P;
+	C_P << 4, 0, -1.5, 0, 0, 2, 0, 0.6, -1.5, 0, 4, 0, 0, 0.6, 0, 2;
+	C_P *= 1e-4;
+	const Eigen::Vector2d extra(3e-4, 5e-4);
+	const CornerCovariance C0 = cornerCovarianceFromPrimary(corners, cam, C_P, 0.9, 0.5);
+	const CornerCovariance C1 = cornerCovarianceFromPrimary(corners, cam, C_P, 0.9, 0.5, extra);
+	// Corner order TL, TR, BR, BL; edge 0 = TL-BL, edge 1 = TR-BR; tilt =
+	// (x_top - x_bottom) / 2.
+	for (int e = 0; e < 2; ++e)
+	{
+		const int top = e == 0 ? 0 : 1, bottom = e == 0 ? 3 : 2;
+		Eigen::Matrix<double, 8, 1> t = Eigen::Matrix<double, 8, 1>::Zero();
+		t[2 * top] = 0.5;
+		t[2 * bottom] = -0.5;
+		EXPECT_NEAR(t.dot(C0 * t), 0.25 * C_P(2 * e, 2 * e), 1e-12) << e;
+		EXPECT_NEAR(t.dot(C1 * t) - t.dot(C0 * t), extra[e], 1e-12) << e;
+	}
+	Eigen::Matrix<double, 4, 8> J;
+	for (int k = 0; k < 8; ++k)
+	{
+		auto p = corners, m = corners;
+		p[k / 2][k % 2] += 1e-5;
+		m[k / 2][k % 2] -= 1e-5;
+		J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
+	}
+	EXPECT_LT((J * C1 * J.transpose() - C_P).norm(), 1e-6 * C_P.norm());
+
+	// measure(): on only above the reference noise; a ratio equal to
+	// corner_tilt_ratio changes nothing, a larger one widens the general
+	// path's C_L.
+	PoseOptions o;
+	o.method = PoseMethod::General6Dof;
+	o.sigma_px = 0.03;
+	o.corner_tilt_ratio = 0.5;
+	o.reference_noise_grey = 2;
+	o.noise_sigma_x_table = sigmaTableFromString("20:0.02 200:0.02");
+	o.noise_sigma_y_table = sigmaTableFromString("20:0.02 200:0.02");
+	Detection d;
+	d.corners = corners;
+	const auto cl = [&](double noise, double k)
+	{
+		o.corner_tilt_noise_ratio = k;
+		d.quality.image_noise_grey = noise;
+		return measure(d, cam, g, o).C_L;
+	};
+	EXPECT_LT((cl(2, 1.7) - cl(2, 0)).norm(), 1e-15);
+	EXPECT_LT((cl(5, 0.5) - cl(5, 0)).norm(), 1e-9 * cl(5, 0).norm());
+	// Wider in every direction (the difference positive semi-definite), the
+	// range's variance by over 10% here (the tilts carry the pitch, which
+	// trades off against the range).
+	const Eigen::Matrix3d base = cl(5, 0), wider = cl(5, 1.7) - base;
+	EXPECT_GT(
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(wider).eigenvalues().minCoeff(),
+		-1e-9 * base.norm());
+	EXPECT_GT(wider(0, 0), 0.1 * base(0, 0));
+	o.corner_tilt_noise_ratio = -1;
+	EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
 TEST(General, CorrelatedCornerCovarianceMatchesMonteCarlo)
 {
 	// Corners drawn from a correlated covariance (x1, x2 anti-correlated as

@@ -154,7 +154,7 @@ GeneralPose solveGeneralPose(
 
 CornerCovariance cornerCovarianceFromPrimary(
 	const std::array<Eigen::Vector2d, 4>& raw, const CameraModel& cam, const Eigen::Matrix4d& C_P,
-	double midpoint_ratio, double tilt_ratio)
+	double midpoint_ratio, double tilt_ratio, const Eigen::Vector2d& tilt_extra_var)
 {
 	// T: ideal corners -> [x1 y1 x2 y2 m1 m2 t1 t2]; its first four rows are
 	// dP/dcorners of primaryMeasurementFromIdeal() (x1, x2 the means of the
@@ -182,7 +182,8 @@ CornerCovariance cornerCovarianceFromPrimary(
 	for (int e = 0; e < 2; ++e)
 	{
 		Cc(4 + e, 4 + e) = midpoint_ratio * midpoint_ratio * C_P(2 * e + 1, 2 * e + 1);
-		Cc(6 + e, 6 + e) = tilt_ratio * tilt_ratio * C_P(2 * e, 2 * e);
+		Cc(6 + e, 6 + e) =
+			std::max(0.0, tilt_ratio * tilt_ratio * C_P(2 * e, 2 * e) + tilt_extra_var[e]);
 	}
 	const CornerCovariance Ti = T.inverse();
 	const CornerCovariance C = Ti * Cc * Ti.transpose();

@@ -144,6 +144,15 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * noise. ini keys `corner_midpoint_ratio`, `corner_tilt_ratio`. */
 	double corner_midpoint_ratio = 1.0;
 	double corner_tilt_ratio = 1.0;	 //!< see corner_midpoint_ratio
+	/** General path, an image noisier than reference_noise_grey: the
+	 * standard deviation of the edges' tilt gained with the noise over the
+	 * one x_i gains (noiseScale()); the tilt's variance is then
+	 * corner_tilt_ratio^2 var_ref(x_i) + corner_tilt_noise_ratio^2 (var(x_i)
+	 * - var_ref(x_i)). A tilt gains more from the noise than from the
+	 * detector's bias, which shifts whole lines (a line fit's slope takes 3x
+	 * the variance of its offset at the ends). 0: corner_tilt_ratio for both
+	 * parts. ini key `corner_tilt_noise_ratio`. */
+	double corner_tilt_noise_ratio = 0;
 	/** Standard deviation added to the edge of each side whose green fill
 	 * clipped throughout (DetectionQuality::fill_clipped) [px]: its edge
 	 * rests on the dark half of the transition alone, 2-5x less certain than
