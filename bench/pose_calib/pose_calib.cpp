@@ -62,7 +62,45 @@ struct Sample
 		if (component == 2) return clipped[1];
 		return int(clipped[0]) + int(clipped[2]);
 	}
+	/** Each vertical edge's midpoint height and tilt errors (the corners'
+	 * four numbers P does not hold, pose::cornerCovarianceFromPrimary()). */
+	Eigen::Vector2d midpointErrors() const
+	{
+		return {(e_corner[1] + e_corner[7]) / 2, (e_corner[3] + e_corner[5]) / 2};
+	}
+	Eigen::Vector2d tiltErrors() const
+	{
+		return {(e_corner[0] - e_corner[6]) / 2, (e_corner[2] - e_corner[4]) / 2};
+	}
 };
+
+/** Means over \a v of the squared errors over their variances: x_i and y_i
+ * of P, and the edges' midpoints and tilts against y_i's and x_i's; \a var
+ * (sample, component of P) the variance. */
+struct Normalised
+{
+	double x = 0, y = 0, midpoint = 0, tilt = 0;
+};
+template <class Var>
+Normalised normalised(const std::vector<Sample>& v, const Var& var)
+{
+	Normalised z;
+	for (const Sample& s : v)
+	{
+		const Eigen::Vector2d m = s.midpointErrors(), t = s.tiltErrors();
+		const double v0 = var(s, 0), v1 = var(s, 1), v2 = var(s, 2), v3 = var(s, 3);
+		z.x += (s.e_P[0] * s.e_P[0] / v0 + s.e_P[2] * s.e_P[2] / v2) / 2;
+		z.y += (s.e_P[1] * s.e_P[1] / v1 + s.e_P[3] * s.e_P[3] / v3) / 2;
+		z.midpoint += (m[0] * m[0] / v1 + m[1] * m[1] / v3) / 2;
+		z.tilt += (t[0] * t[0] / v0 + t[1] * t[1] / v2) / 2;
+	}
+	const double n = std::max<size_t>(1, v.size());
+	z.x /= n;
+	z.y /= n;
+	z.midpoint /= n;
+	z.tilt /= n;
+	return z;
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -514,25 +552,14 @@ int main(int argc, char** argv)
 					}
 				}
 			}
-			double zx = 0, zy = 0, zm2 = 0, zt2 = 0;
-			for (const auto& s : samples)
-			{
-				zx += (s.e_P[0] * s.e_P[0] / var(s, 0) + s.e_P[2] * s.e_P[2] / var(s, 2)) / 2;
-				zy += (s.e_P[1] * s.e_P[1] / var(s, 1) + s.e_P[3] * s.e_P[3] / var(s, 3)) / 2;
-				const auto& e = s.e_corner;
-				const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
-				const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
-				zm2 += (m1 * m1 / var(s, 1) + m2 * m2 / var(s, 3)) / 2;
-				zt2 += (t1 * t1 / var(s, 0) + t2 * t2 / var(s, 2)) / 2;
-			}
-			const double n = samples.size();
+			const Normalised z1 = normalised(samples, var);
 			std::printf("tabulated fit (the same clipped_side_sigma_px):\n");
 			std::printf("  sigma_x_table = %s\n", pose::toString(tx).c_str());
 			std::printf("  sigma_y_table = %s\n", pose::toString(ty).c_str());
 			std::printf(
 				"  corr_growth_x12 %+.2f corr_growth_y12 %+.2f; normalised variance x %.3f y %.3f; "
 				"corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n",
-				rx, ry, zx / n, zy / n, std::sqrt(zm2 / n), std::sqrt(zt2 / n));
+				rx, ry, z1.x, z1.y, std::sqrt(z1.midpoint), std::sqrt(z1.tilt));
 			std::printf(
 				"  aligned_edge_ratio %.1f (%d detections with a top or bottom edge along a row)\n",
 				k_aligned, n_aligned);
@@ -642,46 +669,25 @@ int main(int argc, char** argv)
 							std::pow(pose::interpolateSigma(x ? nx : ny, sizeOf(sm, x)), 2);
 						return v * (1 + (r * r - 1) * std::min(1.0, ns2 / v));
 					};
-					double zx2 = 0, zy2 = 0, zm = 0, zt = 0;
-					for (const Sample& sm : second)
-					{
-						zx2 += (sm.e_P[0] * sm.e_P[0] / var2(sm, 0) +
-								sm.e_P[2] * sm.e_P[2] / var2(sm, 2)) / 2;
-						zy2 += (sm.e_P[1] * sm.e_P[1] / var2(sm, 1) +
-								sm.e_P[3] * sm.e_P[3] / var2(sm, 3)) / 2;
-						const auto& e = sm.e_corner;
-						const double m1 = (e[1] + e[7]) / 2, m2 = (e[3] + e[5]) / 2;
-						const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
-						zm += (m1 * m1 / var2(sm, 1) + m2 * m2 / var2(sm, 3)) / 2;
-						zt += (t1 * t1 / var2(sm, 0) + t2 * t2 / var2(sm, 2)) / 2;
-					}
-					const double n2 = second.size();
+					const Normalised z2 = normalised(second, var2);
 					std::printf(
 						"  at noise %.2f with the split: normalised variance x %.3f y %.3f; "
 						"corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n",
-						r2.noise_sigma, zx2 / n2, zy2 / n2, std::sqrt(zm / n2), std::sqrt(zt / n2));
+						r2.noise_sigma, z2.x, z2.y, std::sqrt(z2.midpoint), std::sqrt(z2.tilt));
 					// An edge's tilt gains more from the noise than its position
 					// (a line fit's end points: the slope's share is 3x the
 					// offset's), and less from the detector's bias (whole lines
 					// shift): the ratio of its noise-driven part to x's
 					// (PoseOptions::corner_tilt_noise_ratio) that makes its
 					// normalised variance 1 at the second noise, by bisection.
-					const double tilt = std::sqrt(zt2 / n);
+					const double tilt2 = z1.tilt;
 					const auto tiltZ = [&](double k)
 					{
-						double z = 0;
-						for (const Sample& sm : second)
-						{
-							const auto& e = sm.e_corner;
-							const double t1 = (e[0] - e[6]) / 2, t2 = (e[2] - e[4]) / 2;
-							const auto v = [&](int c)
-							{
-								return tilt * tilt * var(sm, c) +
-									   k * k * (var2(sm, c) - var(sm, c));
-							};
-							z += (t1 * t1 / v(0) + t2 * t2 / v(2)) / 2;
-						}
-						return z / n2;
+						return normalised(
+								   second,
+								   [&](const Sample& sm, int c)
+								   { return tilt2 * var(sm, c) + k * k * (var2(sm, c) - var(sm, c)); })
+							.tilt;
 					};
 					double lo = 0, hi = 10;
 					if (tiltZ(lo) > 1 && tiltZ(hi) < 1)

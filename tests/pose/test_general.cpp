@@ -283,6 +283,24 @@ TEST(General, CovarianceMatchesMonteCarlo)
 	EXPECT_LT((CR - ref.C_R).norm() / ref.C_R.norm(), 0.15);
 }
 
+namespace
+{
+/** dP/dcorners by central differences of primaryMeasurement (raw pixels). */
+Eigen::Matrix<double, 4, 8> primaryJacobian(
+	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& cam)
+{
+	Eigen::Matrix<double, 4, 8> J;
+	for (int k = 0; k < 8; ++k)
+	{
+		auto p = corners, m = corners;
+		p[k / 2][k % 2] += 1e-5;
+		m[k / 2][k % 2] -= 1e-5;
+		J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
+	}
+	return J;
+}
+}  // namespace
+
 TEST(General, CornerCovarianceFromPrimaryReproducesCP)
 {
 	// dP/dcorners (central differences of primaryMeasurement, raw pixels,
@@ -298,14 +316,7 @@ TEST(General, CornerCovarianceFromPrimaryReproducesCP)
 		C_P << 4, 0, -1.5, 0, 0, 2, 0, 0.6, -1.5, 0, 4, 0, 0, 0.6, 0, 2;
 		C_P *= 1e-4;
 		const CornerCovariance C = cornerCovarianceFromPrimary(corners, cam, C_P);
-		Eigen::Matrix<double, 4, 8> J;
-		for (int k = 0; k < 8; ++k)
-		{
-			auto p = corners, m = corners;
-			p[k / 2][k % 2] += 1e-5;
-			m[k / 2][k % 2] -= 1e-5;
-			J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
-		}
+		const Eigen::Matrix<double, 4, 8> J = primaryJacobian(corners, cam);
 		const Eigen::Matrix4d back = J * C * J.transpose();
 		EXPECT_LT((back - C_P).norm(), 1e-6 * C_P.norm()) << "d " << d;
 		EXPECT_LT((C - C.transpose()).norm(), 1e-12 * C.norm());
@@ -338,14 +349,7 @@ TEST(General, TiltTakesItsOwnShareOfTheNoise)
 		EXPECT_NEAR(t.dot(C0 * t), 0.25 * C_P(2 * e, 2 * e), 1e-12) << e;
 		EXPECT_NEAR(t.dot(C1 * t) - t.dot(C0 * t), extra[e], 1e-12) << e;
 	}
-	Eigen::Matrix<double, 4, 8> J;
-	for (int k = 0; k < 8; ++k)
-	{
-		auto p = corners, m = corners;
-		p[k / 2][k % 2] += 1e-5;
-		m[k / 2][k % 2] -= 1e-5;
-		J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
-	}
+	const Eigen::Matrix<double, 4, 8> J = primaryJacobian(corners, cam);
 	EXPECT_LT((J * C1 * J.transpose() - C_P).norm(), 1e-6 * C_P.norm());
 
 	// measure(): on only above the reference noise; a ratio equal to
