@@ -685,8 +685,10 @@ int main(int argc, char** argv)
 					{
 						return normalised(
 								   second,
-								   [&](const Sample& sm, int c)
-								   { return tilt2 * var(sm, c) + k * k * (var2(sm, c) - var(sm, c)); })
+								   [&](const Sample& sm, int c) {
+									   return tilt2 * var(sm, c) +
+											  k * k * (var2(sm, c) - var(sm, c));
+								   })
 							.tilt;
 					};
 					double lo = 0, hi = 10;

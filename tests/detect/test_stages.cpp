@@ -891,7 +891,7 @@ TEST(Code, AmbiguousCellIsRejected)
 // with most of its window covered by edges and clipped pixels.
 TEST(Noise, SurroundIsTheFlatBlocksNoise)
 {
-	const Quad q{{{100, 100}, {130, 100}, {130, 130}, {100, 130}}};	// 30 px: a 90 px window
+	const Quad q{{{100, 100}, {130, 100}, {130, 130}, {100, 130}}};	 // 30 px: a 90 px window
 	for (const double sigma : {1.0, 2.0, 5.0})
 	{
 		std::mt19937 rng(7);

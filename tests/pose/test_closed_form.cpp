@@ -381,14 +381,10 @@ TEST(Options, LoadSaveAndMethodNames)
 	// Not numbers at all (MRPT would read 0.03 and 0), not booleans (MRPT's
 	// read_bool would take them as false): named, not taken.
 	const std::pair<const char*, const char*> bad_values[] = {
-		{"clipped_side_sigma_px", "0.03px"},
-		{"lm_max_iterations", "0.03px"},
-		{"fold_ambiguity", "maybe"},
-		{"reference_noise_grey", "2 grey"},
-		{"corner_tilt_noise_ratio", "1.4x"},
-		{"noise_sigma_x_table", "20:0.01 10:0.02"},
-		{"refine_on_primary", "maybe"},
-		{"second_order_pose_covariance", "true ; note"}};
+		{"clipped_side_sigma_px", "0.03px"}, {"lm_max_iterations", "0.03px"},
+		{"fold_ambiguity", "maybe"},		 {"reference_noise_grey", "2 grey"},
+		{"corner_tilt_noise_ratio", "1.4x"}, {"noise_sigma_x_table", "20:0.01 10:0.02"},
+		{"refine_on_primary", "maybe"},		 {"second_order_pose_covariance", "true ; note"}};
 	for (const auto& [key, value] : bad_values)
 	{
 		mrpt::config::CConfigFileMemory bad;

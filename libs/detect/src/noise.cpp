@@ -103,7 +103,6 @@ std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, doub
 	return n > 0 ? std::sqrt(ss / n / 2) : 0.0;
 }
 
-
 namespace
 {
 // Flat blocks: 8 x 8 px, each 8 rows of 7 horizontal differences.

@@ -141,7 +141,8 @@ void PoseOptions::validate() const
 		throw std::invalid_argument(
 			"pose options: corner_midpoint_ratio, corner_tilt_ratio must be finite and > 0");
 	if (!(corner_tilt_noise_ratio >= 0) || !std::isfinite(corner_tilt_noise_ratio))
-		throw std::invalid_argument("pose options: corner_tilt_noise_ratio must be finite and >= 0");
+		throw std::invalid_argument(
+			"pose options: corner_tilt_noise_ratio must be finite and >= 0");
 	if (!(reference_noise_grey >= 0) || !std::isfinite(reference_noise_grey))
 		throw std::invalid_argument("pose options: reference_noise_grey must be finite and >= 0");
 	for (const SigmaTable* t :
@@ -463,8 +464,8 @@ Measurement measureWith(
 	Eigen::Vector2d tilt_extra = Eigen::Vector2d::Zero();
 	if (options.corner_tilt_noise_ratio > 0 && image_noise_grey > 0)
 	{
-		const Eigen::Matrix4d grown = options.primaryCovariance(m.P, image_noise_grey) -
-									  options.primaryCovariance(m.P, 0);
+		const Eigen::Matrix4d grown =
+			options.primaryCovariance(m.P, image_noise_grey) - options.primaryCovariance(m.P, 0);
 		const double k2 = options.corner_tilt_noise_ratio * options.corner_tilt_noise_ratio -
 						  options.corner_tilt_ratio * options.corner_tilt_ratio;
 		tilt_extra = k2 * Eigen::Vector2d(grown(0, 0), grown(2, 2));
