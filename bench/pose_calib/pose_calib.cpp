@@ -659,15 +659,15 @@ int main(int argc, char** argv)
 				// there, which the noise scaling assumes unchanged.
 				if (!nx.empty() && !ny.empty())
 				{
+					pose::PoseOptions split_options;
+					split_options.reference_noise_grey = ref_measured;
+					split_options.noise_sigma_x_table = nx;
+					split_options.noise_sigma_y_table = ny;
 					const auto var2 = [&](const Sample& sm, int c)
 					{
 						const bool x = c % 2 == 0;
-						const double r =
-							sm.image_noise > 0 ? std::max(1.0, sm.image_noise / ref_measured) : 1.0;
 						const double v = var(sm, c);
-						const double ns2 =
-							std::pow(pose::interpolateSigma(x ? nx : ny, sizeOf(sm, x)), 2);
-						return v * (1 + (r * r - 1) * std::min(1.0, ns2 / v));
+						return v * split_options.noiseScale(x, sizeOf(sm, x), v, sm.image_noise);
 					};
 					const Normalised z2 = normalised(second, var2);
 					std::printf(

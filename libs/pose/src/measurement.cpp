@@ -376,8 +376,8 @@ Measurement measureWith(
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	m.C_P =
-		options.primaryCovariance(m.P, image_noise_grey) + options.clippedSidesCovariance(clipped);
+	const Eigen::Matrix4d C_primary = options.primaryCovariance(m.P, image_noise_grey);
+	m.C_P = C_primary + options.clippedSidesCovariance(clipped);
 	if (options.aligned_edge_ratio > 0)
 	{
 		// Rows between the ends of the top (TL, TR) and bottom (BL, BR) edges.
@@ -464,8 +464,7 @@ Measurement measureWith(
 	Eigen::Vector2d tilt_extra = Eigen::Vector2d::Zero();
 	if (options.corner_tilt_noise_ratio > 0 && image_noise_grey > 0)
 	{
-		const Eigen::Matrix4d grown =
-			options.primaryCovariance(m.P, image_noise_grey) - options.primaryCovariance(m.P, 0);
+		const Eigen::Matrix4d grown = C_primary - options.primaryCovariance(m.P, 0);
 		const double k2 = options.corner_tilt_noise_ratio * options.corner_tilt_noise_ratio -
 						  options.corner_tilt_ratio * options.corner_tilt_ratio;
 		tilt_extra = k2 * Eigen::Vector2d(grown(0, 0), grown(2, 2));
