@@ -563,6 +563,44 @@ int main(int argc, char** argv)
 			std::printf(
 				"  aligned_edge_ratio %.1f (%d detections with a top or bottom edge along a row)\n",
 				k_aligned, n_aligned);
+			// The tilt ratio against the apparent height
+			// (PoseOptions::corner_tilt_ratio_table): far, the detector's line
+			// fits err by shifts of whole lines, near by tilts too. Bins a
+			// factor 1.25 in height wide, of at least 100 detections (the
+			// ratio then good to about 5%).
+			pose::SigmaTable tt;
+			{
+				std::vector<size_t> order(samples.size());
+				for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+				std::sort(
+					order.begin(), order.end(),
+					[&](size_t a, size_t b) { return samples[a].side_px < samples[b].side_px; });
+				size_t b0 = 0;
+				while (b0 < order.size())
+				{
+					size_t b1 = b0;
+					const double start = samples[order[b0]].side_px;
+					while (b1 < order.size() &&
+						   (b1 - b0 < 100 || samples[order[b1]].side_px < 1.25 * start))
+						++b1;
+					if (order.size() - b1 < 100) b1 = order.size();
+					double zt = 0;
+					for (size_t k = b0; k < b1; ++k)
+					{
+						const Sample& sm = samples[order[k]];
+						const Eigen::Vector2d t = sm.tiltErrors();
+						zt += (t[0] * t[0] / var(sm, 0) + t[1] * t[1] / var(sm, 2)) / 2;
+					}
+					const double size = std::round(10 * samples[order[(b0 + b1) / 2]].side_px) / 10;
+					const double ratio = std::round(100 * std::sqrt(zt / (b1 - b0))) / 100;
+					if ((tt.empty() || size > tt.back().first) && ratio > 0)
+						tt.emplace_back(size, ratio);
+					b0 = b1;
+				}
+			}
+			std::printf("  corner_tilt_ratio_table = %s\n", pose::toString(tt).c_str());
+			const auto tiltRatio2 = [&](const Sample& sm)
+			{ return std::pow(pose::interpolateSigma(tt, sm.side_px), 2); };
 			if (noise_split_arg.getValue() > 0)
 			{
 				sim::RenderOptions r2 = ro;
@@ -680,13 +718,13 @@ int main(int argc, char** argv)
 					// shift): the ratio of its noise-driven part to x's
 					// (PoseOptions::corner_tilt_noise_ratio) that makes its
 					// normalised variance 1 at the second noise, by bisection.
-					const double tilt2 = z1.tilt;
+					// The tilts' reference part: corner_tilt_ratio_table's.
 					const auto tiltZ = [&](double k)
 					{
 						return normalised(
 								   second,
 								   [&](const Sample& sm, int c) {
-									   return tilt2 * var(sm, c) +
+									   return tiltRatio2(sm) * var(sm, c) +
 											  k * k * (var2(sm, c) - var(sm, c));
 								   })
 							.tilt;

@@ -384,6 +384,51 @@ TEST(General, TiltTakesItsOwnShareOfTheNoise)
 	EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
+// corner_tilt_ratio_table: the tilt ratio at the sighting's apparent
+// height y1 + y2, interpolated as the sigma tables (clamped at the ends,
+// log-linear between), in place of corner_tilt_ratio.
+TEST(General, TiltRatioFollowsTheApparentHeight)
+{
+	PoseOptions o;
+	o.corner_tilt_ratio = 0.6;
+	EXPECT_DOUBLE_EQ(o.cornerTiltRatio(50), 0.6);
+	o.corner_tilt_ratio_table = sigmaTableFromString("30:0.3 120:0.9");
+	EXPECT_DOUBLE_EQ(o.cornerTiltRatio(10), 0.3);
+	EXPECT_DOUBLE_EQ(o.cornerTiltRatio(500), 0.9);
+	EXPECT_NEAR(o.cornerTiltRatio(60), std::sqrt(0.3 * 0.9), 1e-12);  // the geometric midpoint
+
+	// measure(): a table whose value at this sighting's height is the scalar
+	// ratio gives the scalar's C_L; a larger value there widens it.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const auto corners = projectCorners(cameraAt(1.5, 0.4, 0.1, 0.05), cam, g);
+	PoseOptions s;
+	s.method = PoseMethod::General6Dof;
+	s.sigma_px = 0.03;
+	s.corner_tilt_ratio = 0.5;
+	const Measurement scalar = measure(corners, cam, g, s);
+	const double height = scalar.P[1] + scalar.P[3];
+	PoseOptions t = s;
+	t.corner_tilt_ratio = 7;  // unused with the table
+	t.corner_tilt_ratio_table = {{0.5 * height, 0.5}, {2 * height, 0.5}};
+	EXPECT_LT((measure(corners, cam, g, t).C_L - scalar.C_L).norm(), 1e-12 * scalar.C_L.norm());
+	t.corner_tilt_ratio_table = {{0.5 * height, 0.1}, {height, 1.5}, {2 * height, 0.1}};
+	const Eigen::Matrix3d wider = measure(corners, cam, g, t).C_L - scalar.C_L;
+	EXPECT_GT(
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(wider).eigenvalues().minCoeff(),
+		-1e-9 * scalar.C_L.norm());
+	EXPECT_GT(wider.trace(), 0.05 * scalar.C_L.trace());
+	// The closed form does not use it.
+	t.method = s.method = PoseMethod::ClosedForm;
+	EXPECT_LT(
+		(measure(corners, cam, g, t).C_L - measure(corners, cam, g, s).C_L).norm(),
+		1e-15 * scalar.C_L.norm());
+	t.corner_tilt_ratio_table = {{50, 0.5}, {40, 0.6}};	 // sizes must increase
+	EXPECT_THROW(t.validate(), std::invalid_argument);
+	t.corner_tilt_ratio_table = {{50, 0.5}, {60, 0}};  // ratios must be > 0
+	EXPECT_THROW(t.validate(), std::invalid_argument);
+}
+
 TEST(General, CorrelatedCornerCovarianceMatchesMonteCarlo)
 {
 	// Corners drawn from a correlated covariance (x1, x2 anti-correlated as

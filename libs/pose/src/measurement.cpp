@@ -146,7 +146,8 @@ void PoseOptions::validate() const
 	if (!(reference_noise_grey >= 0) || !std::isfinite(reference_noise_grey))
 		throw std::invalid_argument("pose options: reference_noise_grey must be finite and >= 0");
 	for (const SigmaTable* t :
-		 {&sigma_x_table, &sigma_y_table, &noise_sigma_x_table, &noise_sigma_y_table})
+		 {&sigma_x_table, &sigma_y_table, &noise_sigma_x_table, &noise_sigma_y_table,
+		  &corner_tilt_ratio_table})
 		for (size_t k = 0; k < t->size(); ++k)
 			if (!((*t)[k].first > 0) || !((*t)[k].second > 0) || !std::isfinite((*t)[k].second) ||
 				(k > 0 && !((*t)[k].first > (*t)[k - 1].first)))
@@ -180,6 +181,8 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(reference_noise_grey, double, c, s);
 	noise_sigma_x_table = readSigmaTable(c, s, "noise_sigma_x_table", noise_sigma_x_table);
 	noise_sigma_y_table = readSigmaTable(c, s, "noise_sigma_y_table", noise_sigma_y_table);
+	corner_tilt_ratio_table =
+		readSigmaTable(c, s, "corner_tilt_ratio_table", corner_tilt_ratio_table);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_x, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_y, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_reference_px, double, c, s);
@@ -262,6 +265,9 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 		s, "corner_tilt_ratio", corner_tilt_ratio, -1, -1,
 		"General6Dof: sigma of an edge's tilt over sigma(x_i)");
 	c.write(
+		s, "corner_tilt_ratio_table", toString(corner_tilt_ratio_table), -1, -1,
+		"General6Dof: size:ratio pairs against y1 + y2 [px]; replace corner_tilt_ratio");
+	c.write(
 		s, "corner_tilt_noise_ratio", corner_tilt_noise_ratio, -1, -1,
 		"General6Dof: the same for the part that grows with the image noise; 0: the same ratio");
 	c.write(
@@ -291,6 +297,12 @@ double PoseOptions::noiseScale(bool x, double size_px, double var, double image_
 	const double r = std::max(1.0, image_noise_grey / reference_noise_grey);
 	const double share = std::min(1.0, std::pow(interpolateSigma(t, size_px), 2) / var);
 	return 1 + (r * r - 1) * share;
+}
+
+double PoseOptions::cornerTiltRatio(double height_px) const
+{
+	return corner_tilt_ratio_table.empty() ? corner_tilt_ratio
+										   : interpolateSigma(corner_tilt_ratio_table, height_px);
 }
 
 Eigen::Matrix4d PoseOptions::primaryCovariance(
@@ -460,20 +472,21 @@ Measurement measureWith(
 	// from 2 to 5 m on the accuracy map (mean NEES 3.95 against [2.80,
 	// 3.21]), matched to its diagonal conservative on the realistic renders
 	// of test_pose_nees.cpp (2.66 against [2.72, 3.29]).
+	// The tilt ratio at this sighting's apparent height (corner_tilt_ratio_table).
+	const double tilt_ratio = options.cornerTiltRatio(m.P[1] + m.P[3]);
 	// The tilts' own share of the noise's growth (corner_tilt_noise_ratio).
 	Eigen::Vector2d tilt_extra = Eigen::Vector2d::Zero();
 	if (options.corner_tilt_noise_ratio > 0 && image_noise_grey > 0)
 	{
 		const Eigen::Matrix4d grown = C_primary - options.primaryCovariance(m.P, 0);
 		const double k2 = options.corner_tilt_noise_ratio * options.corner_tilt_noise_ratio -
-						  options.corner_tilt_ratio * options.corner_tilt_ratio;
+						  tilt_ratio * tilt_ratio;
 		tilt_extra = k2 * Eigen::Vector2d(grown(0, 0), grown(2, 2));
 	}
 	const GeneralPose g = solveGeneralPose(
 		corners, camera, geometry,
 		cornerCovarianceFromPrimary(
-			corners, camera, m.C_P, options.corner_midpoint_ratio, options.corner_tilt_ratio,
-			tilt_extra),
+			corners, camera, m.C_P, options.corner_midpoint_ratio, tilt_ratio, tilt_extra),
 		options.lm_max_iterations);
 	// The planar pose is poseFromLandmark(L) on this path too: the same
 	// curvature beyond 2 m (poseCovarianceSecondOrder()).
@@ -503,9 +516,9 @@ Measurement measureWith(
 		reducePnPSolution(other);
 		const MeasurementMode second = generalMode(other);
 		fold(best, second);
-		if (m.second_mode_weight > 0 && secondModeWeight(best, second) > 0.5)
+		if (m.second_mode_weight > 0 && second.chi2 < best.chi2)
 		{
-			// The second solution is the more probable one: its 6-DoF pose.
+			// The second solution fits better (foldModes() kept it): its 6-DoF pose.
 			m.landmark_T_camera = g.solutions[1].landmark_T_camera;
 			m.reprojection_rms_px = g.solutions[1].rms_px;
 		}

@@ -144,6 +144,17 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * noise. ini keys `corner_midpoint_ratio`, `corner_tilt_ratio`. */
 	double corner_midpoint_ratio = 1.0;
 	double corner_tilt_ratio = 1.0;	 //!< see corner_midpoint_ratio
+	/** corner_tilt_ratio tabulated against the apparent height y1 + y2 (the
+	 * vertical edges' length) [px], interpolated as the sigma tables; when
+	 * not empty, in place of corner_tilt_ratio. The detector's tilt ratio is
+	 * no constant: far (edges under about 50 px) its line fits err by
+	 * shifts of whole lines and the ratio reads 0.3-0.4, near (over 65 px)
+	 * 0.85-0.9 (codemark-bench-pose-calib): the one ratio made the general
+	 * path overconfident within 2 m and pessimistic beyond. ini key
+	 * `corner_tilt_ratio_table` = "size:ratio size:ratio ...". */
+	SigmaTable corner_tilt_ratio_table;
+	/** corner_tilt_ratio, or its table's value at apparent height \a height_px. */
+	double cornerTiltRatio(double height_px) const;
 	/** General path, an image noisier than reference_noise_grey: the
 	 * standard deviation of the edges' tilt gained with the noise over the
 	 * one x_i gains (noiseScale()); the tilt's variance is then
