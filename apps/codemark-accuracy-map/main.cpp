@@ -74,7 +74,12 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg fold_arg(
 			"", "fold-ambiguity",
 			"Both paths weigh the mirror-image solution against the kept one and fold it into "
-			"C_L and C_R (PoseOptions::fold_ambiguity, off by default).",
+			"C_L and C_R (PoseOptions::fold_ambiguity; the default, kept for old command lines).",
+			cmd, false);
+		TCLAP::SwitchArg no_fold_arg(
+			"", "no-fold-ambiguity",
+			"Each path reports its kept solution's local C_L and C_R alone (PoseOptions::"
+			"fold_ambiguity off): the far, square-on cells then show the mirror image's cost.",
 			cmd, false);
 		TCLAP::SwitchArg realistic_arg(
 			"", "realistic",
@@ -130,7 +135,10 @@ int main(int argc, char** argv)
 		if (!detector_arg.getValue().empty())
 			o.detector = codemark::detect::DetectorOptions::load(detector_arg.getValue());
 		if (paper_arg.getValue()) o.pose.refine_on_primary = false;
-		if (fold_arg.getValue()) o.pose.fold_ambiguity = true;
+		if (fold_arg.getValue() && no_fold_arg.getValue())
+			throw std::invalid_argument(
+				"--fold-ambiguity and --no-fold-ambiguity exclude each other");
+		o.pose.fold_ambiguity = !no_fold_arg.getValue();
 		o.realistic = realistic_arg.getValue();
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)

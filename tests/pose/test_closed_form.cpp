@@ -249,6 +249,9 @@ TEST(ClosedForm, CovariancePropagation)
 	PoseOptions opt;
 	opt.sigma_px = 0.3;
 	opt.refine_on_primary = false;
+	// The local covariance; at 0.3 px the mirror image would be folded in
+	// (test_ambiguity.cpp).
+	opt.fold_ambiguity = false;
 	const auto corners = projectCorners(cameraAt(2.0, 0.5, 0.1, 0.1), cam, g);
 	const Measurement m = measure(corners, cam, g, opt);
 	Eigen::Matrix<double, 3, 4> J_P;
@@ -360,9 +363,10 @@ TEST(Options, LoadSaveAndMethodNames)
 	EXPECT_DOUBLE_EQ(o.sigma_px, kDefaultSigmaPx);
 	o.method = PoseMethod::General6Dof;
 	o.sigma_px = 0.2;
-	o.fold_ambiguity = true;
+	o.fold_ambiguity = false;  // not the default
 	o.reference_noise_grey = 2;
 	o.corner_tilt_noise_ratio = 1.4;
+	o.corner_tilt_ratio_table = sigmaTableFromString("30:0.3 90:0.9");
 	o.noise_sigma_x_table = sigmaTableFromString("20:0.01 80:0.004");
 	o.noise_sigma_y_table = sigmaTableFromString("30:0.012");
 	mrpt::config::CConfigFileMemory cfg;
@@ -371,8 +375,9 @@ TEST(Options, LoadSaveAndMethodNames)
 	r.loadFromConfigFile(cfg, "POSE");
 	EXPECT_EQ(r.method, PoseMethod::General6Dof);
 	EXPECT_DOUBLE_EQ(r.sigma_px, 0.2);
-	EXPECT_TRUE(r.fold_ambiguity);
+	EXPECT_FALSE(r.fold_ambiguity);
 	EXPECT_DOUBLE_EQ(r.reference_noise_grey, 2);
+	EXPECT_EQ(r.corner_tilt_ratio_table, o.corner_tilt_ratio_table);
 	EXPECT_DOUBLE_EQ(r.corner_tilt_noise_ratio, 1.4);
 	EXPECT_EQ(r.noise_sigma_x_table, o.noise_sigma_x_table);
 	EXPECT_EQ(r.noise_sigma_y_table, o.noise_sigma_y_table);
@@ -381,10 +386,15 @@ TEST(Options, LoadSaveAndMethodNames)
 	// Not numbers at all (MRPT would read 0.03 and 0), not booleans (MRPT's
 	// read_bool would take them as false): named, not taken.
 	const std::pair<const char*, const char*> bad_values[] = {
-		{"clipped_side_sigma_px", "0.03px"}, {"lm_max_iterations", "0.03px"},
-		{"fold_ambiguity", "maybe"},		 {"reference_noise_grey", "2 grey"},
-		{"corner_tilt_noise_ratio", "1.4x"}, {"noise_sigma_x_table", "20:0.01 10:0.02"},
-		{"refine_on_primary", "maybe"},		 {"second_order_pose_covariance", "true ; note"}};
+		{"clipped_side_sigma_px", "0.03px"},
+		{"lm_max_iterations", "0.03px"},
+		{"fold_ambiguity", "maybe"},
+		{"reference_noise_grey", "2 grey"},
+		{"corner_tilt_noise_ratio", "1.4x"},
+		{"noise_sigma_x_table", "20:0.01 10:0.02"},
+		{"refine_on_primary", "maybe"},
+		{"second_order_pose_covariance", "true ; note"},
+		{"corner_tilt_ratio_table", "30:0.3 20:0.4"}};
 	for (const auto& [key, value] : bad_values)
 	{
 		mrpt::config::CConfigFileMemory bad;
@@ -414,6 +424,7 @@ TEST(Options, SigmaFromTheDetector)
 	d.quality.corner_sigma_px = 0.2;
 	PoseOptions o;
 	o.sigma_px = 0.05;
+	o.fold_ambiguity = false;  // the local covariances scale with sigma^2
 	const Measurement fixed = measure(d, cam, g, o);
 	o.sigma_source = SigmaSource::Detector;
 	const Measurement det = measure(d, cam, g, o);
