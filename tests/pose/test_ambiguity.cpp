@@ -64,20 +64,17 @@ TEST(Ambiguity, FoldModesWeighsByMassAndCoversTheOtherMode)
 	// A wider mode holds more mass: twice the sigma of phi2 doubles it.
 	const MeasurementMode wide = modeAt(-0.15, 1.0, 2 * s);
 	EXPECT_NEAR(secondModeWeight(a, wide), 2.0 / 3.0, 1e-12);
-	// The better fit is kept, whichever comes first, even when the other
-	// holds more mass (a wider mode that fits as well or a little worse):
-	// the weight of the other then exceeds one half, and the covariance
-	// covers it.
+	// The first (the caller's best fit) is kept even when the other holds
+	// more mass (a wider mode that fits as well or a little worse): the
+	// other's weight then exceeds one half, and the covariance covers it.
 	const MeasurementMode g = foldModes(a, wide, &w);
 	EXPECT_DOUBLE_EQ(g.L[2], a.L[2]);
 	EXPECT_NEAR(w, 2.0 / 3.0, 1e-12);
 	EXPECT_NEAR(g.C_L(2, 2), s * s / 3 + 2.0 / 3.0 * (4 * s * s + 0.25 * 0.25), 1e-12);
 	const MeasurementMode wide_worse = modeAt(-0.15, 1.5, 2 * s);
-	EXPECT_DOUBLE_EQ(foldModes(wide_worse, a, &w).L[2], a.L[2]);
+	EXPECT_DOUBLE_EQ(foldModes(a, wide_worse, &w).L[2], a.L[2]);
 	EXPECT_NEAR(w, secondModeWeight(a, wide_worse), 1e-12);
 	EXPECT_GT(w, 0.5);
-	const MeasurementMode better = modeAt(-0.15, 0.5, s);
-	EXPECT_DOUBLE_EQ(foldModes(a, better).L[2], better.L[2]);
 	// A mode that does not fit at all changes nothing.
 	const MeasurementMode far = modeAt(-0.15, 1e4, s);
 	const MeasurementMode h = foldModes(a, far, &w);

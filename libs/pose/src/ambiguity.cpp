@@ -17,14 +17,12 @@ MeasurementMode foldModes(
 	const MeasurementMode& a, const MeasurementMode& b, double* other_weight,
 	MeasurementMode* other)
 {
-	// The better fit is kept (on exact corners the truth): a wider mode
-	// can hold more mass with a worse fit, and reporting it would move the
-	// estimate off the data. Its weight may then exceed one half.
-	const double wb = secondModeWeight(a, b);
-	const bool keep_a = a.chi2 <= b.chi2;
-	const MeasurementMode& k = keep_a ? a : b;
-	const MeasurementMode& o = keep_a ? b : a;
-	const double w = keep_a ? wb : 1 - wb;
+	// The caller's best fit is kept (on exact corners the truth): a wider
+	// mode can hold more mass with a worse fit, and reporting it would move
+	// the estimate off the data. The other's weight may then exceed one half.
+	const MeasurementMode& k = a;
+	const MeasurementMode& o = b;
+	const double w = secondModeWeight(a, b);
 	Eigen::Vector3d dL = o.L - k.L, dR = o.pose_in_landmark - k.pose_in_landmark;
 	dL[1] = wrapToPi(dL[1]);
 	dL[2] = wrapToPi(dL[2]);

@@ -455,7 +455,15 @@ Measurement measureWith(
 				const Eigen::Vector3d L_mirror =
 					refineLandmarkOnPrimary(m.P, m.C_P, lambda, h, L0, &C_mirror);
 				if (C_mirror.allFinite() && C_mirror.determinant() > 0)
-					fold(closedFormMode(m.L, m.C_L), closedFormMode(L_mirror, C_mirror));
+				{
+					// The better fit is kept (foldModes()).
+					const MeasurementMode a = closedFormMode(m.L, m.C_L),
+										  b = closedFormMode(L_mirror, C_mirror);
+					if (a.chi2 <= b.chi2)
+						fold(a, b);
+					else
+						fold(b, a);
+				}
 			}
 			catch (const std::invalid_argument&)
 			{
@@ -515,13 +523,8 @@ Measurement measureWith(
 		PnPSolution other = g.solutions[1];
 		reducePnPSolution(other);
 		const MeasurementMode second = generalMode(other);
+		// IPPE's better solution (the lower RMS reprojection error) is kept.
 		fold(best, second);
-		if (m.second_mode_weight > 0 && second.chi2 < best.chi2)
-		{
-			// The second solution fits better (foldModes() kept it): its 6-DoF pose.
-			m.landmark_T_camera = g.solutions[1].landmark_T_camera;
-			m.reprojection_rms_px = g.solutions[1].rms_px;
-		}
 	}
 	return m;
 }

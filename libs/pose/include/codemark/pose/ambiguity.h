@@ -13,7 +13,7 @@
  * 1.5 deg of a truth 12 deg away (NEES in the thousands,
  * docs/benchmarks/pose.md). Here the two modes are weighed by Laplace's
  * approximation of their probability mass, and the reported covariance is
- * the mean squared error about the better-fitting mode over both: the
+ * the mean squared error about the best-fitting mode over both: the
  * smallest covariance that stays honest whichever mode is true.
  */
 #include <Eigen/Core>
@@ -43,14 +43,14 @@ struct MeasurementMode
  * exp(-chi2 / 2) sqrt(det cov)). 0.5 for two equal modes. */
 double secondModeWeight(const MeasurementMode& a, const MeasurementMode& b);
 
-/** \a a and \a b folded into one mode: the better-fitting one's L and pose
- * (the lower chi2; \a a on a tie), each covariance the mean squared error
- * about them over the two-mode mixture, (1 - w) C_kept + w (C_other + d
- * d^T), w the other mode's probability (secondModeWeight(); above 0.5 when
- * the other fits almost as well and is wider) and d the difference of the
- * means (angles wrapped). \a other_weight, if not null, receives w; \a
- * other, if not null, the mode not kept. chi2 and log_det_cov are the kept
- * mode's. */
+/** \a b folded into \a a, the caller's best fit (measure(): the lower chi2
+ * on the closed form, the lower RMS reprojection error on the general
+ * path): \a a's L and pose, each covariance the mean squared error about
+ * them over the two-mode mixture, (1 - w) C_a + w (C_b + d d^T), w = \a b's
+ * probability (secondModeWeight(); above 0.5 when \a b fits almost as well
+ * and is wider) and d the difference of the means (angles wrapped). \a
+ * other_weight, if not null, receives w; \a other, if not null, \a b.
+ * chi2 and log_det_cov are \a a's. */
 MeasurementMode foldModes(
 	const MeasurementMode& a, const MeasurementMode& b, double* other_weight = nullptr,
 	MeasurementMode* other = nullptr);
