@@ -265,7 +265,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * Closed form refined on P (refine_on_primary) and general path. On by
 	 * default: one sighting's C_L and C_R are then honest on their own (the
 	 * accuracy map from 2 to 5 m at noise 2, 40 renders a cell: closed form
-	 * mean NEES 2.80 folded against 6.04 unfolded). The shipped EKF configs
+	 * mean NEES 2.81 folded against 6.04 unfolded). The shipped EKF configs
 	 * turn it off: a filter fuses the same far landmark frame after frame,
 	 * whose mirror image wins or loses by the same detector bias each time,
 	 * and there the fold makes the loops' NEES 4% low (ekf.ini). ini key
