@@ -101,6 +101,41 @@ Normalised normalised(const std::vector<Sample>& v, const Var& var)
 	z.tilt /= n;
 	return z;
 }
+
+/** One bin of sizeBins(): its samples in order of size, and its median size
+ * rounded to 0.1 px. */
+struct SizeBin
+{
+	std::vector<const Sample*> samples;
+	double size_px = 0;
+};
+/** \a v sorted by \a size (sample -> px), cut into bins a factor 1.25 in size
+ * wide, of at least \a min_count samples; a short remainder joins the last
+ * bin. The calibration's tables are fitted per bin. */
+template <class Size>
+std::vector<SizeBin> sizeBins(const std::vector<Sample>& v, const Size& size, size_t min_count)
+{
+	std::vector<size_t> order(v.size());
+	for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+	std::sort(
+		order.begin(), order.end(), [&](size_t a, size_t b) { return size(v[a]) < size(v[b]); });
+	std::vector<SizeBin> bins;
+	size_t b0 = 0;
+	while (b0 < order.size())
+	{
+		size_t b1 = b0;
+		const double start = size(v[order[b0]]);
+		while (b1 < order.size() && (b1 - b0 < min_count || size(v[order[b1]]) < 1.25 * start))
+			++b1;
+		if (order.size() - b1 < min_count) b1 = order.size();
+		SizeBin bin;
+		for (size_t k = b0; k < b1; ++k) bin.samples.push_back(&v[order[k]]);
+		bin.size_px = std::round(10 * size(v[order[(b0 + b1) / 2]])) / 10;
+		bins.push_back(std::move(bin));
+		b0 = b1;
+	}
+	return bins;
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -444,51 +479,32 @@ int main(int argc, char** argv)
 			{ return c % 2 == 0 ? 0.0 : 0.25 * k_aligned * k_aligned * s.aligned_weight; };
 			const auto table = [&](bool x)
 			{
-				std::vector<size_t> order(samples.size());
-				for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-				std::sort(
-					order.begin(), order.end(),
-					[&](size_t a, size_t b)
-					{ return sizeOf(samples[a], x) < sizeOf(samples[b], x); });
-				// Bins a factor 1.25 in size wide, of at least 40 detections.
+				// Bins of at least 40 detections.
 				pose::SigmaTable t;
-				size_t b0 = 0;
-				while (b0 < order.size())
+				for (const SizeBin& bin : sizeBins(
+						 samples, [&](const Sample& s) { return sizeOf(s, x); }, 40))
 				{
-					size_t b1 = b0;
-					const double start = sizeOf(samples[order[b0]], x);
-					while (b1 < order.size() &&
-						   (b1 - b0 < 40 || sizeOf(samples[order[b1]], x) < 1.25 * start))
-						++b1;
-					// A short remainder joins the last bin.
-					if (order.size() - b1 < 40) b1 = order.size();
 					double best = 1e300, best_sigma = 0;
 					for (int g = 0; g <= 400; ++g)
 					{
 						const double sg = 1e-4 * std::pow(1e4, g / 400.0), v0 = sg * sg;
 						double nll = 0;
-						for (size_t k = b0; k < b1; ++k)
-						{
-							const Sample& s = samples[order[k]];
+						for (const Sample* s : bin.samples)
 							for (const int c : {x ? 0 : 1, x ? 2 : 3})
 							{
-								const double v = v0 * (1 + aligned(s, c)) + share(s, c);
-								nll += s.e_P[c] * s.e_P[c] / v + std::log(v);
+								const double v = v0 * (1 + aligned(*s, c)) + share(*s, c);
+								nll += s->e_P[c] * s->e_P[c] / v + std::log(v);
 							}
-						}
 						if (nll < best)
 						{
 							best = nll;
 							best_sigma = sg;
 						}
 					}
-					// The bin's median size, rounded (0.1 px, 3 digits of sigma).
-					const double size =
-						std::round(10 * sizeOf(samples[order[(b0 + b1) / 2]], x)) / 10;
+					// 3 digits of sigma.
 					const double p10 = std::pow(10, std::floor(std::log10(best_sigma)) - 2);
-					if (t.empty() || size > t.back().first)
-						t.emplace_back(size, std::round(best_sigma / p10) * p10);
-					b0 = b1;
+					if (t.empty() || bin.size_px > t.back().first)
+						t.emplace_back(bin.size_px, std::round(best_sigma / p10) * p10);
 				}
 				return t;
 			};
@@ -565,42 +581,26 @@ int main(int argc, char** argv)
 				k_aligned, n_aligned);
 			// The tilt ratio against the apparent height
 			// (PoseOptions::corner_tilt_ratio_table): far, the detector's line
-			// fits err by shifts of whole lines, near by tilts too. Bins a
-			// factor 1.25 in height wide, of at least 100 detections (the
-			// ratio then good to about 5%).
+			// fits err by shifts of whole lines, near by tilts too. Bins of at
+			// least 100 detections (the ratio then good to about 5%).
 			pose::SigmaTable tt;
+			for (const SizeBin& bin : sizeBins(
+					 samples, [](const Sample& s) { return s.side_px; }, 100))
 			{
-				std::vector<size_t> order(samples.size());
-				for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-				std::sort(
-					order.begin(), order.end(),
-					[&](size_t a, size_t b) { return samples[a].side_px < samples[b].side_px; });
-				size_t b0 = 0;
-				while (b0 < order.size())
+				double zt = 0;
+				for (const Sample* sm : bin.samples)
 				{
-					size_t b1 = b0;
-					const double start = samples[order[b0]].side_px;
-					while (b1 < order.size() &&
-						   (b1 - b0 < 100 || samples[order[b1]].side_px < 1.25 * start))
-						++b1;
-					if (order.size() - b1 < 100) b1 = order.size();
-					double zt = 0;
-					for (size_t k = b0; k < b1; ++k)
-					{
-						const Sample& sm = samples[order[k]];
-						const Eigen::Vector2d t = sm.tiltErrors();
-						zt += (t[0] * t[0] / var(sm, 0) + t[1] * t[1] / var(sm, 2)) / 2;
-					}
-					const double size = std::round(10 * samples[order[(b0 + b1) / 2]].side_px) / 10;
-					const double ratio = std::round(100 * std::sqrt(zt / (b1 - b0))) / 100;
-					if ((tt.empty() || size > tt.back().first) && ratio > 0)
-						tt.emplace_back(size, ratio);
-					b0 = b1;
+					const Eigen::Vector2d t = sm->tiltErrors();
+					zt += (t[0] * t[0] / var(*sm, 0) + t[1] * t[1] / var(*sm, 2)) / 2;
 				}
+				const double ratio = std::round(100 * std::sqrt(zt / bin.samples.size())) / 100;
+				if ((tt.empty() || bin.size_px > tt.back().first) && ratio > 0)
+					tt.emplace_back(bin.size_px, ratio);
 			}
 			std::printf("  corner_tilt_ratio_table = %s\n", pose::toString(tt).c_str());
+			// The one ratio where no bin gives one (exact renders: no tilt error).
 			const auto tiltRatio2 = [&](const Sample& sm)
-			{ return std::pow(pose::interpolateSigma(tt, sm.side_px), 2); };
+			{ return tt.empty() ? z1.tilt : std::pow(pose::interpolateSigma(tt, sm.side_px), 2); };
 			if (noise_split_arg.getValue() > 0)
 			{
 				sim::RenderOptions r2 = ro;

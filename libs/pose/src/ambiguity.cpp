@@ -13,25 +13,20 @@ double secondModeWeight(const MeasurementMode& a, const MeasurementMode& b)
 	return 1.0 / (1.0 + std::exp(log_ratio));
 }
 
-MeasurementMode foldModes(
-	const MeasurementMode& a, const MeasurementMode& b, double* other_weight,
-	MeasurementMode* other)
+MeasurementMode foldModes(const MeasurementMode& a, const MeasurementMode& b, double* other_weight)
 {
 	// The caller's best fit is kept (on exact corners the truth): a wider
 	// mode can hold more mass with a worse fit, and reporting it would move
 	// the estimate off the data. The other's weight may then exceed one half.
-	const MeasurementMode& k = a;
-	const MeasurementMode& o = b;
 	const double w = secondModeWeight(a, b);
-	Eigen::Vector3d dL = o.L - k.L, dR = o.pose_in_landmark - k.pose_in_landmark;
+	Eigen::Vector3d dL = b.L - a.L, dR = b.pose_in_landmark - a.pose_in_landmark;
 	dL[1] = wrapToPi(dL[1]);
 	dL[2] = wrapToPi(dL[2]);
 	dR[2] = wrapToPi(dR[2]);
-	MeasurementMode out = k;
-	out.C_L = (1 - w) * k.C_L + w * (o.C_L + dL * dL.transpose());
-	out.C_R = (1 - w) * k.C_R + w * (o.C_R + dR * dR.transpose());
+	MeasurementMode out = a;
+	out.C_L = (1 - w) * a.C_L + w * (b.C_L + dL * dL.transpose());
+	out.C_R = (1 - w) * a.C_R + w * (b.C_R + dR * dR.transpose());
 	if (other_weight) *other_weight = w;
-	if (other) *other = o;
 	return out;
 }
 

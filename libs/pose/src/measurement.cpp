@@ -409,9 +409,8 @@ Measurement measureWith(
 		// (both starts reached the same valley floor).
 		const double dphi2 = std::abs(wrapToPi(b.L[2] - a.L[2]));
 		if (!(dphi2 > 0.1 * std::sqrt(std::min(a.C_L(2, 2), b.C_L(2, 2))))) return;
-		MeasurementMode other;
-		const MeasurementMode k = foldModes(a, b, &m.second_mode_weight, &other);
-		m.second_mode_L = other.L;
+		const MeasurementMode k = foldModes(a, b, &m.second_mode_weight);
+		m.second_mode_L = b.L;
 		m.L = k.L;
 		m.C_L = k.C_L;
 		m.pose_in_landmark = k.pose_in_landmark;

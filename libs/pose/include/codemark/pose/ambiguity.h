@@ -49,10 +49,8 @@ double secondModeWeight(const MeasurementMode& a, const MeasurementMode& b);
  * them over the two-mode mixture, (1 - w) C_a + w (C_b + d d^T), w = \a b's
  * probability (secondModeWeight(); above 0.5 when \a b fits almost as well
  * and is wider) and d the difference of the means (angles wrapped). \a
- * other_weight, if not null, receives w; \a other, if not null, \a b.
- * chi2 and log_det_cov are \a a's. */
+ * other_weight, if not null, receives w. chi2 and log_det_cov are \a a's. */
 MeasurementMode foldModes(
-	const MeasurementMode& a, const MeasurementMode& b, double* other_weight = nullptr,
-	MeasurementMode* other = nullptr);
+	const MeasurementMode& a, const MeasurementMode& b, double* other_weight = nullptr);
 
 }  // namespace codemark::pose

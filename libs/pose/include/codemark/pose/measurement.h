@@ -157,11 +157,11 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double cornerTiltRatio(double height_px) const;
 	/** General path, an image noisier than reference_noise_grey: the
 	 * standard deviation of the edges' tilt gained with the noise over the
-	 * one x_i gains (noiseScale()); the tilt's variance is then
-	 * corner_tilt_ratio^2 var_ref(x_i) + corner_tilt_noise_ratio^2 (var(x_i)
-	 * - var_ref(x_i)). A tilt gains more from the noise than from the
-	 * detector's bias, which shifts whole lines (a line fit's slope takes 3x
-	 * the variance of its offset at the ends). 0: corner_tilt_ratio for both
+	 * one x_i gains (noiseScale()); the tilt's variance is then r^2
+	 * var_ref(x_i) + corner_tilt_noise_ratio^2 (var(x_i) - var_ref(x_i)), r
+	 * the tilt ratio (cornerTiltRatio()). A tilt gains more from the noise
+	 * than from the detector's bias, which shifts whole lines (a line fit's
+	 * slope takes 3x the variance of its offset at the ends). 0: r for both
 	 * parts. ini key `corner_tilt_noise_ratio`. */
 	double corner_tilt_noise_ratio = 0;
 	/** Standard deviation added to the edge of each side whose green fill
@@ -258,8 +258,9 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** Weigh the measurement's second local optimum, the landmark's mirror
 	 * image about the line of sight (view angle phi1 + phi2 -> -(phi1 +
 	 * phi2), IPPE's second solution on the general path), against the first
-	 * and report the more probable one with the mean squared error over both
-	 * as C_L and C_R (foldModes(), ambiguity.h). Far and near-frontal the
+	 * and report the better fit (the lower chi2 on the closed form, IPPE's
+	 * lower reprojection error on the general path) with the mean squared
+	 * error over both as C_L and C_R (foldModes(), ambiguity.h). Far and near-frontal the
 	 * two fit the corners almost equally, and the local covariance alone
 	 * put phi2 within 1.5 deg of a truth 12 deg away (docs/benchmarks/pose.md).
 	 * Closed form refined on P (refine_on_primary) and general path. On by
@@ -309,7 +310,8 @@ struct Measurement
 	double ambiguity_ratio = 0;
 	/** With PoseOptions::fold_ambiguity: the probability of the second
 	 * local optimum (the mirror image about the line of sight), folded into
-	 * C_L and C_R; 0 when there is none or folding is off. */
+	 * C_L and C_R (above 0.5 when it fits almost as well and is wider); 0
+	 * when there is none or folding is off. */
 	double second_mode_weight = 0;
 	/** That optimum's L when second_mode_weight > 0. */
 	Eigen::Vector3d second_mode_L = Eigen::Vector3d::Zero();
