@@ -11,6 +11,7 @@ PACKAGES=(
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
   libapriltag-dev libcairo2-dev libtclap-dev
   xvfb xdotool imagemagick
+  povray
   python3 clang-14 libclang-rt-14-dev clang-tidy-14 clang-format-14 clang-tools-14
 )
 

@@ -414,30 +414,6 @@ void applyIllumination(cv::Mat& img, const RenderOptions& o)
 	}
 }
 
-/** Linear motion blur: a normalised line kernel of \a length_px along
- * \a angle_rad (counter-clockwise from +u as displayed, i.e. towards -v),
- * with bilinear splats for sub-pixel lengths. */
-void applyMotionBlur(cv::Mat& img, double length_px, double angle_rad)
-{
-	if (!(length_px > 0)) return;
-	const int half = static_cast<int>(std::ceil(0.5 * length_px)) + 1;
-	cv::Mat k = cv::Mat::zeros(2 * half + 1, 2 * half + 1, CV_32F);
-	const int steps = std::max(16, static_cast<int>(std::ceil(8 * length_px)));
-	const double ca = std::cos(angle_rad), sa = std::sin(angle_rad);
-	for (int i = 0; i < steps; ++i)
-	{
-		const double t = length_px * ((i + 0.5) / steps - 0.5);
-		const double x = half + t * ca, y = half - t * sa;
-		const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-		const double fx = x - x0, fy = y - y0;
-		k.at<float>(y0, x0) += float((1 - fx) * (1 - fy));
-		k.at<float>(y0, x0 + 1) += float(fx * (1 - fy));
-		k.at<float>(y0 + 1, x0) += float((1 - fx) * fy);
-		k.at<float>(y0 + 1, x0 + 1) += float(fx * fy);
-	}
-	k /= cv::sum(k)[0];
-	cv::filter2D(img, img, -1, k, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
-}
 }  // namespace
 
 std::vector<LandmarkTruth> groundTruth(const Scene& scene)
@@ -486,27 +462,9 @@ Render render(const Scene& scene, const RenderOptions& o, uint64_t seed)
 			drawLandmarkExact(img, cam, cam_T_lm[i], face, o);
 	}
 
-	// Illumination, then the optics (blur), then the sensor (noise,
-	// quantisation), then the codec.
+	// The scene's light, then the camera with this frame's draws.
 	applyIllumination(img, o);
-	if (o.blur_sigma_px > 0)
-		cv::GaussianBlur(
-			img, img, cv::Size(0, 0), o.blur_sigma_px, o.blur_sigma_px, cv::BORDER_REPLICATE);
-	applyMotionBlur(img, o.motion_blur_px, o.motion_blur_angle_rad);
-	if (o.noise_sigma > 0)
-	{
-		cv::RNG rng(detail::streamSeed(seed, 4));
-		cv::Mat noise(img.size(), img.type());
-		rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
-		img += noise;
-	}
-	img.convertTo(out.image, CV_8UC3);	// rounds and clamps to 0..255
-	if (o.jpeg_quality > 0)
-	{
-		std::vector<uchar> buf;
-		cv::imencode(".jpg", out.image, buf, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
-		out.image = cv::imdecode(buf, cv::IMREAD_COLOR);
-	}
+	out.image = cameraImage(img, o.drawn(seed), cam.cx(), cam.cy(), seed);
 	return out;
 }
 

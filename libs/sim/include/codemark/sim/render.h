@@ -7,6 +7,7 @@
 #include <codemark/landmark/camera.h>
 #include <codemark/landmark/map.h>
 #include <codemark/landmark/truth.h>
+#include <codemark/sim/camera_pipeline.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/poses/CPose3D.h>
 
@@ -15,6 +16,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 namespace codemark::sim
@@ -60,6 +63,84 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	double motion_blur_angle_rad = 0.0;
 	int jpeg_quality = 0;  //!< 0 = no JPEG round trip, else 1..100
 
+	/** @name The camera pipeline (camera_pipeline.h), after the optics above
+	 * (blur_sigma_px, motion blur) and before the codec (jpeg_quality).
+	 * Every stage is off at its default.
+	 * @{ */
+	/** Name of the preset these keys started from ("" = none); see
+	 * applyPreset(). */
+	std::string preset;
+	double defocus_radius_px = 0;  //!< defocus disc radius, linear light [px]
+	/** Lateral chromatic aberration: radial shift of R against G at the
+	 * farthest image corner, outwards positive [px]. */
+	double ca_red_px = 0;
+	double ca_blue_px = 0;	//!< the same for B [px]
+	double vignetting = 0;	//!< relative loss of light at the farthest corner [0..0.9]
+	double exposure = 1;  //!< exposure gain of the sensor signal (> 0)
+	double wb_red = 1;	//!< white-balance gain of R against G
+	double wb_blue = 1;	 //!< white-balance gain of B against G
+	/** Electrons at full scale (255); 0 = no shot and read noise. */
+	double full_well_e = 0;
+	double read_noise_e = 0;  //!< read noise RMS [e-] (with full_well_e > 0)
+	BayerLayout bayer = BayerLayout::None;	//!< colour filter array
+	Demosaic demosaic = Demosaic::Bilinear;	 //!< demosaicing, with a Bayer layout
+	Transfer transfer = Transfer::Linear;  //!< transfer curve
+	double gamma = 2.2;	 //!< exponent of Transfer::Gamma
+	double filmic_strength = 0.25;	//!< strength of Transfer::Filmic's S-curve [0..0.9]
+	double unsharp_sigma_px = 1.0;	//!< unsharp mask radius [px]
+	double unsharp_amount = 0;	//!< unsharp mask amount; 0 = no sharpening
+	/** @} */
+
+	/** A numeric key drawn per frame, uniformly in [lo, hi]. */
+	struct RangeDraw
+	{
+		std::string key;
+		double lo = 0, hi = 0;
+	};
+	/** A named choice (bayer, demosaic, transfer) drawn per frame among
+	 * \a names, each equally likely. */
+	struct ChoiceDraw
+	{
+		std::string key;
+		std::vector<std::string> names;
+	};
+	std::vector<RangeDraw> range_draws;	 //!< set from "key = lo hi" in an ini
+	std::vector<ChoiceDraw> choice_draws;  //!< set from "key = NAME NAME ..." or "any"
+
+	/** These options with every range and choice drawn for one frame:
+	 * deterministic for \a seed, no draws left. */
+	RenderOptions drawn(uint64_t seed) const;
+	/** True when a stage of the camera pipeline beyond the renderer's own
+	 * (blur, motion blur, noise, JPEG) is on, or anything is drawn. */
+	bool hasCameraStages() const;
+
+	/** Sets the camera pipeline's keys (and the optics', noise's and codec's:
+	 * blur_sigma_px, noise_sigma, jpeg_quality) to the preset \a name, the
+	 * scene's keys (background, colours, light, occlusion) untouched:
+	 *  - `linear`: no stage but sensor noise (full well 10000 e-, read 5 e-);
+	 *  - `machine-vision`: linear transfer, optics sigma 0.5 px, vignetting
+	 *    0.05, full well 20000 e-, read 3 e-, lossless (PNG);
+	 *  - `webcam`: optics sigma 0.6 px, CA +0.3 / -0.3 px, vignetting 0.2,
+	 *    white balance R 1.05 B 0.95, full well 8000 e-, read 6 e-, RGGB
+	 *    with bilinear demosaicing, sRGB, unsharp sigma 1.0 amount 0.5,
+	 *    JPEG 85;
+	 *  - `phone`: optics sigma 0.5 px, CA +0.2 / -0.2 px, vignetting 0.1,
+	 *    full well 5000 e-, read 3 e-, BGGR with edge-aware demosaicing,
+	 *    filmic 0.25, unsharp sigma 1.0 amount 0.9, JPEG 75;
+	 *  - `family`: every range drawn per frame: optics sigma 0-1.2 px,
+	 *    defocus 0-1.5 px, CA -0.7..0.7 px, vignetting 0-0.35, exposure
+	 *    0.5-1.5, white balance 0.75-1.3, full well 5000-20000 e-, read
+	 *    2-10 e-, any Bayer layout and demosaicing, any transfer curve
+	 *    (gamma 1.8-2.6, filmic 0-0.35), unsharp sigma 0.6-1.5 amount 0-1,
+	 *    JPEG 60-95.
+	 * Throws std::invalid_argument naming the key 'preset' and the presets. */
+	void applyPreset(const std::string& name);
+	/** The presets' names, in the order above. */
+	static std::vector<std::string> presetNames();
+	/** The keys that preset \a name sets, as lines of an ini section
+	 * ("key = value"); throws std::invalid_argument for an unknown name. */
+	static std::string presetKeys(const std::string& name);
+
 	/** Fraction [0..1] of each landmark's reference square to hide behind an
 	 * occluder (a grey bar, level 100 at gain 1, in the landmark's plane,
 	 * covering the square from one side chosen from the seed per landmark,
@@ -75,7 +156,12 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	void validate() const;
 
 	/** Reads the keys of this struct from \a section (background by name:
-	 * Flat, Textured or Cluttered; colours as "B G R"), then validate(). */
+	 * Flat, Textured or Cluttered; colours as "B G R"), then validate().
+	 * A `preset` key is applied first, so the section's other keys override
+	 * it. The camera pipeline's numeric keys, blur_sigma_px, noise_sigma and
+	 * jpeg_quality also take "lo hi" (drawn per frame); bayer, demosaic and
+	 * transfer take several names or `any`. An unknown name or a value out
+	 * of its range throws std::invalid_argument naming the key. */
 	void loadFromConfigFile(
 		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 	void saveToConfigFile(
@@ -134,11 +220,15 @@ struct Render
  * in by its exact pixel coverage (or by n x n samples per pixel with lens
  * distortion) together with its occluder, a landmark seen from behind (not
  * facing) not drawn (its back is the wall it hangs on); illumination gain
- * and gradient;
- * Gaussian blur; motion blur; Gaussian noise; rounding and clamping to
- * 0..255; the JPEG round trip. Throws std::invalid_argument on invalid
- * options. */
+ * and gradient; then the camera pipeline (camera_pipeline.h) with the
+ * options drawn for this frame (RenderOptions::drawn(seed)). Throws
+ * std::invalid_argument on invalid options. */
 Render render(const Scene& scene, const RenderOptions& options, uint64_t seed);
+
+/** A renderer: the scene's linear light through the camera pipeline, with
+ * exact ground truth (render() is the project's own; povray.h has an
+ * independent one). */
+using Renderer = std::function<Render(const Scene&, const RenderOptions&, uint64_t seed)>;
 
 /** The ground truth of render() without rendering (cheap): one entry per
  * map landmark, map order; occluded_fraction is 0. */
