@@ -257,6 +257,7 @@ std::vector<CellResult> runSurvey(
 		o.realistic ? sim::DatasetOptions::realisticRender() : sim::RenderOptions();
 	ro.noise_sigma = o.noise_sigma;
 	ro.blur_sigma_px = o.blur_sigma_px;
+	if (!o.preset.empty()) ro.applyPreset(o.preset);
 	const LandmarkGeometry g = lm.geometry();
 	const detect::DetectorOptions& dopt = o.detector;
 	pose::PoseOptions cf = o.pose, gen = o.pose;
@@ -535,8 +536,11 @@ std::string writeResults(
 		{"2 to 5 m, all angles", 2.0 + 1e-9, 5.0 + 1e-9, 90}};
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
-	  << o.renders_per_cell << " renders each, noise " << fmt(o.noise_sigma, 1) << ", blur "
-	  << fmt(o.blur_sigma_px, 2) << " px, C_P " << o.noise_label << ", "
+	  << o.renders_per_cell << " renders each, "
+	  << (o.preset.empty()
+			  ? "noise " + fmt(o.noise_sigma, 1) + ", blur " + fmt(o.blur_sigma_px, 2) + " px"
+			  : "camera preset " + o.preset)
+	  << ", C_P " << o.noise_label << ", "
 	  << (o.realistic ? "realistic scene (textured wall, light gradient, distractors)"
 					  : "plain background")
 	  << ", closed form " << (o.pose.refine_on_primary ? "refined on P" : "paper's formulas alone")

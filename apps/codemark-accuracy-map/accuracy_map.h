@@ -46,6 +46,10 @@ struct SurveyOptions
 	 * of the paper's plain grey background; noise and blur as set. The
 	 * AprilTag renders keep the plain background. */
 	bool realistic = false;
+	/** Camera preset (docs/camera-pipeline.md) for codemark's renders,
+	 * applied after noise_sigma and blur_sigma_px (which it sets); "" =
+	 * none. The AprilTag renders keep the plain noise and blur. */
+	std::string preset;
 	/** Each render aims the camera off the landmark by a bearing drawn
 	 * uniformly within +-aim_jitter_rad and puts it higher or lower by up to
 	 * height_jitter_m (the cell fixes the camera's planar position): a robot

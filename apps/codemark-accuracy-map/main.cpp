@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include <codemark/pipeline/pipeline.h>
+#include <codemark/sim/render.h>
 
 #include "../common/progress.h"
 #include "accuracy_map.h"
@@ -81,6 +82,11 @@ int main(int argc, char** argv)
 			"Each path reports its kept solution's local C_L and C_R alone (PoseOptions::"
 			"fold_ambiguity off): the far, square-on cells then show the mirror image's cost.",
 			cmd, false);
+		TCLAP::ValueArg<std::string> preset_arg(
+			"", "preset",
+			"Camera preset of codemark's renders (linear, machine-vision, webcam, phone, family: "
+			"docs/camera-pipeline.md), in place of --noise and --blur.",
+			false, "", "NAME", cmd);
 		TCLAP::SwitchArg realistic_arg(
 			"", "realistic",
 			"Render codemark's landmark in the realistic scene the C_P calibration was fitted "
@@ -140,6 +146,11 @@ int main(int argc, char** argv)
 				"--fold-ambiguity and --no-fold-ambiguity exclude each other");
 		o.pose.fold_ambiguity = !no_fold_arg.getValue();
 		o.realistic = realistic_arg.getValue();
+		if (preset_arg.isSet())
+		{
+			(void)codemark::sim::RenderOptions::presetKeys(preset_arg.getValue());
+			o.preset = preset_arg.getValue();
+		}
 		o.pose.sigma_source = codemark::pose::sigmaSourceFromString(sigma_source_arg.getValue());
 		if (o.pose.sigma_source == codemark::pose::SigmaSource::Detector)
 			o.noise_label = "the detector's per-detection corner sigma";

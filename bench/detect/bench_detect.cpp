@@ -402,6 +402,7 @@ struct Config
 	std::string dump_dir;  // where codemark's missed sweep frames go (empty: nowhere)
 	std::string clutter_dir;  // where clutter frames with codemark ROIs go (empty: nowhere)
 	int profile_repeat = 0;	 // untimed extra codemark runs per sweep and clutter frame
+	std::string preset;	 // camera preset of every render ("" = blur 0.8, noise 2)
 };
 
 int runBench(const Config& cfg)
@@ -411,12 +412,19 @@ int runBench(const Config& cfg)
 	const CameraModel cam = CameraModel::paperDefault();
 	const codemark::LandmarkGeometry geometry;
 	const codemark::detect::DetectorOptions dopts;
-	const cb::Effects effects;	// blur 0.8, noise 2
 	sim::RenderOptions textured;
 	textured.background = sim::Background::Textured;
 	sim::RenderOptions cluttered;
 	cluttered.background = sim::Background::Cluttered;
 	cluttered.distractors = 12;
+	cb::Effects fx;	 // blur 0.8, noise 2, or the preset's
+	if (!cfg.preset.empty())
+	{
+		textured.applyPreset(cfg.preset);
+		cluttered.applyPreset(cfg.preset);
+		fx = {textured.blur_sigma_px, textured.noise_sigma};
+	}
+	const cb::Effects effects = fx;
 
 	const Aruco aruco;
 	const AprilTag tag1(1.0), tag2(2.0);
@@ -768,9 +776,12 @@ int runBench(const Config& cfg)
 		  "(markers: one cell)\n"
 	   << "- rendering: libs/sim's exact pixel coverage and background for every print "
 		  "(bench/detect/"
-		  "print_render.*), Gaussian blur sigma 0.8 px then noise sigma 2 grey levels, identical "
-		  "for all; "
-		  "check: our landmark rendered this way differs from `sim::render()` by at most "
+		  "print_render.*), "
+	   << (cfg.preset.empty()
+			   ? std::string("Gaussian blur sigma 0.8 px then noise sigma 2 grey levels")
+			   : "the camera pipeline of preset `" + cfg.preset + "` (docs/camera-pipeline.md)")
+	   << ", identical for all; check: our landmark rendered this way differs from "
+		  "`sim::render()` by at most "
 	   << fmt(sim_diff, 0) << " grey level(s)\n"
 	   << "- ground truth: exact projection of the reference square's corners; AprilTag's corners "
 		  "shifted by "
@@ -1101,6 +1112,11 @@ int main(int argc, char** argv)
 			"write the background-only frames in which codemark examines ROIs (PNG) into this "
 			"existing directory",
 			false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> preset(
+			"", "preset",
+			"camera preset of every render (linear, machine-vision, webcam, phone, family: "
+			"docs/camera-pipeline.md); default: Gaussian blur 0.8 px and noise 2 in linear light",
+			false, "", "NAME", cmd);
 		TCLAP::ValueArg<int> profile_repeat(
 			"", "profile-repeat",
 			"run codemark N more times, untimed, on every sweep frame, so that a profiler "
@@ -1125,6 +1141,11 @@ int main(int argc, char** argv)
 		if (profile_repeat.getValue() < 0)
 			throw std::invalid_argument("--profile-repeat must be >= 0");
 		cfg.profile_repeat = profile_repeat.getValue();
+		if (preset.isSet())
+		{
+			(void)sim::RenderOptions::presetKeys(preset.getValue());
+			cfg.preset = preset.getValue();
+		}
 		return runBench(cfg);
 	}
 	catch (const TCLAP::ArgException& e)

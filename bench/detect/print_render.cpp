@@ -275,17 +275,11 @@ Frame renderFrame(
 			}
 		}
 	}
-	if (fx.blur_sigma_px > 0)
-		cv::GaussianBlur(
-			img, img, cv::Size(0, 0), fx.blur_sigma_px, fx.blur_sigma_px, cv::BORDER_REPLICATE);
-	if (fx.noise_sigma > 0)
-	{
-		cv::RNG rng(sim::detail::streamSeed(seed, 4));
-		cv::Mat noise(img.size(), img.type());
-		rng.fill(noise, cv::RNG::NORMAL, 0.0, fx.noise_sigma);
-		img += noise;
-	}
-	img.convertTo(out.bgr, CV_8UC3);
+	// The camera: sim::render()'s pipeline with the effects' blur and noise.
+	sim::RenderOptions camera = o;
+	camera.blur_sigma_px = fx.blur_sigma_px;
+	camera.noise_sigma = fx.noise_sigma;
+	out.bgr = sim::cameraImage(img, camera.drawn(seed), cam.cx(), cam.cy(), seed);
 	return out;
 }
 

@@ -44,6 +44,7 @@ struct Noise
 {
 	std::string name;
 	double noise_sigma, blur_sigma_px;
+	std::string preset;	 // a camera preset in place of the noise and blur ("" = none)
 };
 
 std::vector<RawlogStep> readSteps(
@@ -270,6 +271,11 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> methods(
 			"m", "methods", "comma-separated methods", false, "ekf,ekf-pose,ekf-slam,pf", "LIST",
 			cmd);
+		TCLAP::ValueArg<std::string> presets(
+			"", "preset",
+			"comma-separated camera presets (docs/camera-pipeline.md): one row of images per "
+			"preset in place of the two noise levels",
+			false, "", "LIST", cmd);
 		TCLAP::SwitchArg no_phi2(
 			"", "no-phi2-table",
 			"skip the SLAM comparison with the BearingRange twin (codemark ekf-slam and MRPT's "
@@ -283,8 +289,18 @@ int main(int argc, char** argv)
 			std::stringstream ss(methods.getValue());
 			for (std::string m; std::getline(ss, m, ',');) ms.push_back(m);
 		}
-		const std::vector<Noise> noises = {
-			{"noise 2, blur 0.8 px", 2.0, 0.8}, {"noise 6, blur 1.2 px", 6.0, 1.2}};
+		std::vector<Noise> noises = {
+			{"noise 2, blur 0.8 px", 2.0, 0.8, ""}, {"noise 6, blur 1.2 px", 6.0, 1.2, ""}};
+		if (presets.isSet())
+		{
+			noises.clear();
+			std::stringstream ss(presets.getValue());
+			for (std::string p; std::getline(ss, p, ',');)
+			{
+				(void)sim::RenderOptions::presetKeys(p);  // an unknown name throws
+				noises.push_back({"preset " + p, 0, 0, p});
+			}
+		}
 		std::map<std::pair<std::string, std::string>, Result> results;
 		std::map<std::string, std::string> skipped;
 		std::map<std::pair<std::string, std::string>, SlamRow> slam_rows;
@@ -296,9 +312,12 @@ int main(int argc, char** argv)
 				o.seed = seed;
 				o.render.noise_sigma = nz.noise_sigma;
 				o.render.blur_sigma_px = nz.blur_sigma_px;
+				if (!nz.preset.empty()) o.render.applyPreset(nz.preset);
 				const auto dir =
-					fs::path(work.getValue()) / ("seed" + std::to_string(seed) + "_noise" +
-												 std::to_string(int(nz.noise_sigma)));
+					fs::path(work.getValue()) /
+					("seed" + std::to_string(seed) +
+					 (nz.preset.empty() ? "_noise" + std::to_string(int(nz.noise_sigma))
+										: "_" + nz.preset));
 				std::fprintf(stderr, "filters_sim: dataset %s\n", dir.c_str());
 				fs::create_directories(dir);
 				const auto ds = sim::writeDataset(o, dir.string(), false, {}, frames.getValue());

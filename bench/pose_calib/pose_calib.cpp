@@ -164,6 +164,11 @@ int main(int argc, char** argv)
 			"wall, light gradient, noise 2, blur 0.8) instead of the accuracy map's flat "
 			"background.",
 			cmd, false);
+		TCLAP::ValueArg<std::string> preset_arg(
+			"", "preset",
+			"Camera preset of the renders (docs/camera-pipeline.md), applied after --realistic "
+			"and before --render-config.",
+			false, "", "NAME", cmd);
 		TCLAP::ValueArg<std::string> render_arg(
 			"", "render-config",
 			"Ini file whose [render] section overrides the render options (after --realistic), "
@@ -215,6 +220,7 @@ int main(int argc, char** argv)
 		ro.noise_sigma = 2;
 		ro.blur_sigma_px = 0.8;
 		if (realistic_arg.getValue()) ro = sim::DatasetOptions::realisticRender();
+		if (preset_arg.isSet()) ro.applyPreset(preset_arg.getValue());
 		if (!render_arg.getValue().empty())
 		{
 			// MRPT reads a missing file as an empty one: say so instead.
