@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "errors.h"
+#include "povray_args.h"
 #include "progress.h"
 
 namespace
@@ -99,6 +100,12 @@ int main(int argc, char** argv)
 			"", "height", "generated poses: camera height in the world [m] (default 0.6)", false,
 			0.6, "M", cmd);
 		TCLAP::SwitchArg quietArg("q", "quiet", "no progress indication on stderr", cmd);
+		app::PovrayArgs povArgs(cmd);
+		TCLAP::SwitchArg linearArg(
+			"", "linear",
+			"with --renderer povray: also write linear_000.png, ... (POV-Ray's 16-bit linear "
+			"renders, before the camera pipeline) and povray.ini (the POV-Ray options used)",
+			cmd);
 		cmd.parse(argc, argv);
 
 		const LandmarkMap map = LandmarkMap::load(mapArg.getValue());
@@ -161,6 +168,12 @@ int main(int argc, char** argv)
 			mrpt::config::CConfigFile cfg((out / "render.ini").string());
 			options.saveToConfigFile(cfg, "RENDER");
 		}
+		if (povArgs.povray() && linearArg.getValue())
+		{
+			mrpt::config::CConfigFile cfg((out / "povray.ini").string());
+			povArgs.options().saveToConfigFile(cfg, "povray");
+		}
+		const sim::Renderer renderer = povArgs.make();
 		std::ofstream truth(out / "truth.jsonl");
 		if (!truth) throw std::runtime_error((out / "truth.jsonl").string() + ": cannot write");
 
@@ -172,11 +185,18 @@ int main(int argc, char** argv)
 		for (size_t i = 0; i < poses.size(); ++i)
 		{
 			scene.world_T_camera = poses[i];
-			const sim::Render r = sim::render(scene, options, seedArg.getValue() * 1000003ull + i);
+			const uint64_t frame_seed = seedArg.getValue() * 1000003ull + i;
+			const sim::Render r = renderer(scene, options, frame_seed);
 			char name[32];
 			std::snprintf(name, sizeof(name), "frame_%03zu.png", i);
 			if (!cv::imwrite((out / name).string(), r.image))
 				throw std::runtime_error((out / name).string() + ": cannot write image");
+			if (linearArg.getValue())
+			{
+				char linear[32];
+				std::snprintf(linear, sizeof(linear), "linear_%03zu.png", i);
+				povArgs.saveLinear(scene, options, frame_seed, (out / linear).string());
+			}
 			truth << sim::frameTruthJson(name, scene.world_T_camera, r.truth, camera) << '\n';
 			for (const auto& t : r.truth) in_view += sim::isInView(t, camera);
 			bar.update(static_cast<long>(i + 1), static_cast<long>(poses.size()));

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "errors.h"
+#include "povray_args.h"
 #include "progress.h"
 
 int main(int argc, char** argv)
@@ -41,6 +42,7 @@ int main(int argc, char** argv)
 			"s", "seed", "override [dataset] seed", false, 0, "N", cmd);
 		TCLAP::ValueArg<int> frames(
 			"", "max-frames", "stop after N images (0: the whole trajectory)", false, 0, "N", cmd);
+		codemark::app::PovrayArgs pov(cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
@@ -60,10 +62,11 @@ int main(int argc, char** argv)
 			}
 		}
 		if (seed.isSet()) opts.seed = seed.getValue();
+		const codemark::sim::Renderer renderer = pov.make();
 		codemark::app::ProgressBar bar("codemark-simul", !quiet.getValue());
 		const auto sum = codemark::sim::writeDataset(
 			opts, out.getValue(), obsOnly.getValue(),
-			[&](int done, int total) { bar.update(done, total); }, frames.getValue());
+			[&](int done, int total) { bar.update(done, total); }, frames.getValue(), renderer);
 		bar.finish();
 		std::cout << "codemark-simul: " << sum.frames << " images, " << sum.odometry_readings
 				  << " odometry readings, " << sum.map.landmarks.size() << " landmarks, "

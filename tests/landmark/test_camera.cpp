@@ -174,4 +174,9 @@ TEST(Camera, IniTextRoundTrip)
 	EXPECT_NEAR(back.fx(), cam.fx(), 1e-4);
 	EXPECT_NEAR(back.params().dist[0], cam.params().dist[0], 1e-9);
 	EXPECT_TRUE(back.hasDistortion());
+	// A camera without distortion (codemark-render's camera.ini) too.
+	const CameraModel plain = CameraModel::paperDefault();
+	const CameraModel plain_back = CameraModel::load(writeTemp("cam_rt0.ini", plain.toIniText()));
+	EXPECT_NEAR(plain_back.cx(), plain.cx(), 1e-9);
+	EXPECT_FALSE(plain_back.hasDistortion());
 }

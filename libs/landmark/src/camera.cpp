@@ -354,7 +354,11 @@ mrpt::img::TCamera loadIni(
 	// MRPT reads "8o0" as 8 and "abc" as 0: check the numbers first.
 	requireIniNumbers(cfg, section, {"cx", "cy", "fx", "fy", "focal_length"}, false, false, path);
 	requireIniNumbers(cfg, section, {"resolution"}, true, true, path);
-	requireIniNumbers(cfg, section, {"dist"}, false, true, path);
+	// A camera without distortion writes "dist = []" (toIniText()).
+	std::string dist_compact = dist;
+	dist_compact.erase(
+		std::remove_if(dist_compact.begin(), dist_compact.end(), ::isspace), dist_compact.end());
+	if (dist_compact != "[]") requireIniNumbers(cfg, section, {"dist"}, false, true, path);
 	for (const char* key : {"resolution", "cx", "cy", "fx", "fy"})
 		if (!cfg.keyExists(section, key))
 			throw std::runtime_error(
