@@ -370,7 +370,7 @@ mrpt::obs::CActionRobotMovement2D::Ptr odometryAction(
 
 DatasetSummary writeDataset(
 	const DatasetOptions& o, const std::string& out_dir, bool obs_only,
-	const std::function<void(int, int)>& progress, int max_frames)
+	const std::function<void(int, int)>& progress, int max_frames, const Renderer& renderer)
 {
 	DatasetSummary sum;
 	sum.map = o.map_file.empty() ? generateRoomMap(o) : LandmarkMap::load(o.map_file);
@@ -451,7 +451,7 @@ DatasetSummary writeDataset(
 		}
 
 		Scene scene{sum.map, camera, CPose3D(f.pose) + cam_on_robot};
-		const Render r = render(scene, o.render, static_cast<uint64_t>(o.seed) * 1000003ULL + k);
+		const Render r = renderer(scene, o.render, static_cast<uint64_t>(o.seed) * 1000003ULL + k);
 		for (const auto& t : r.truth) sum.sightings += t.fully_visible;
 		std::ostringstream name;
 		name << o.sensor_label << "_" << std::setw(6) << std::setfill('0') << k << ".png";

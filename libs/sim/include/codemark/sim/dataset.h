@@ -111,10 +111,12 @@ struct DatasetSummary
  * or observations-only with \a obs_only), images in `dataset_Images/`,
  * `map.txt`, `gt_path.txt` (`timestamp x y yaw` per image). Calls
  * \a progress(done, total) after each frame; stops after \a max_frames
- * images when > 0. Deterministic for o.seed.
- * Throws std::runtime_error on I/O errors or an unusable setup. */
+ * images when > 0. The images come from \a renderer (the project's own
+ * render() by default; povrayRenderer() for POV-Ray's). Deterministic for
+ * o.seed. Throws std::runtime_error on I/O errors or an unusable setup. */
 DatasetSummary writeDataset(
 	const DatasetOptions& o, const std::string& out_dir, bool obs_only,
-	const std::function<void(int, int)>& progress = {}, int max_frames = 0);
+	const std::function<void(int, int)>& progress = {}, int max_frames = 0,
+	const Renderer& renderer = Renderer(render));
 
 }  // namespace codemark::sim
