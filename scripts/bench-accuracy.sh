@@ -9,15 +9,27 @@
 # a scratch folder instead.
 #
 # Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
+#        [--presets LIST [--renders N]]
+# --presets LIST (comma-separated camera presets, docs/camera-pipeline.md)
+# runs, instead of the above, the calibration tool and the accuracy map
+# once per preset (codemark's renders through that camera; AprilTag's keep
+# noise 2 and blur 0.8) and writes
+# apps/codemark-accuracy-map/results/presets/NAME/ (summary.txt, cells.csv,
+# heat maps, calibration.txt); --renders sets the map's renders per cell
+# (default 4).
 # Environment: BUILD_DIR (default build-bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir="${BUILD_DIR:-build-bench}"
 quick=0
+presets=""
+renders=4
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
+    --presets) presets="$2"; shift 2 ;;
+    --renders) renders="$2"; shift 2 ;;
     *) echo "bench-accuracy.sh: unknown option $1" >&2; exit 1 ;;
   esac
 done
@@ -25,6 +37,18 @@ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCODEMARK_BUILD_BENCH=ON 
 cmake --build "$build_dir" -j"$(nproc)" --target codemark-bench-pose-calib codemark-accuracy-map codemark-uncertainty
 calib="$build_dir/bench/pose_calib/codemark-bench-pose-calib"
 map="$build_dir/apps/codemark-accuracy-map/codemark-accuracy-map"
+if [[ -n "$presets" ]]; then
+  IFS=',' read -r -a names <<<"$presets"
+  for p in "${names[@]}"; do
+    dir="apps/codemark-accuracy-map/results/presets/$p"
+    mkdir -p "$dir"
+    echo "== preset $p: C_P calibration data (realistic scenes) and accuracy map ($renders renders a cell)"
+    "$calib" --renders 1200 --seed 7 --realistic --preset "$p" --max-bearing 0.35 --max-height 0.5 \
+      --max-distance 6 --max-angle 60 --uniform-distance --averaged >"$dir/calibration.txt"
+    "$map" --out "$dir" --renders "$renders" --preset "$p"
+  done
+  exit 0
+fi
 if [[ $quick -eq 1 ]]; then
   "$calib" --renders 200 --realistic --max-bearing 0.35 --max-height 0.5
   "$map" --out "$build_dir/accuracy-map-quick" --renders 1 --max-distance 2

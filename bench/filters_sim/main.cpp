@@ -10,6 +10,7 @@
 #include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
+#include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/config/CConfigFile.h>
@@ -21,6 +22,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <random>
@@ -45,7 +47,31 @@ struct Noise
 	std::string name;
 	double noise_sigma, blur_sigma_px;
 	std::string preset;	 // a camera preset in place of the noise and blur ("" = none)
+	std::string dataset_dir;  // an existing dataset (codemark-simul's output) in place of one
 };
+
+/** The map and ground truth of a dataset folder written by codemark-simul
+ * (map.txt, gt_path.txt: `timestamp x y yaw` per image). */
+sim::DatasetSummary loadDataset(const fs::path& dir)
+{
+	sim::DatasetSummary ds;
+	ds.map = LandmarkMap::load((dir / "map.txt").string());
+	const fs::path gt = dir / "gt_path.txt";
+	std::ifstream in(gt);
+	if (!in) throw std::runtime_error(gt.string() + ": cannot open");
+	std::string line;
+	for (int n = 1; std::getline(in, line); ++n)
+	{
+		const auto v = parseNumberRow(line, gt.string(), n);
+		if (v.empty()) continue;
+		if (v.size() != 4)
+			throw std::runtime_error(
+				gt.string() + ":" + std::to_string(n) + ": expected 'timestamp x y yaw'");
+		ds.ground_truth.push_back({v[0], mrpt::poses::CPose2D(v[1], v[2], v[3])});
+	}
+	ds.frames = static_cast<int>(ds.ground_truth.size());
+	return ds;
+}
 
 std::vector<RawlogStep> readSteps(
 	const std::string& rawlog, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map)
@@ -276,6 +302,11 @@ int main(int argc, char** argv)
 			"comma-separated camera presets (docs/camera-pipeline.md): one row of images per "
 			"preset in place of the two noise levels",
 			false, "", "LIST", cmd);
+		TCLAP::MultiArg<std::string> datasets(
+			"", "dataset",
+			"NAME=DIR: also run every method on an existing dataset of codemark-simul (e.g. the "
+			"POV-Ray room loop of scripts/povray-sets.sh), one row named NAME; repeatable",
+			false, "NAME=DIR", cmd);
 		TCLAP::SwitchArg no_phi2(
 			"", "no-phi2-table",
 			"skip the SLAM comparison with the BearingRange twin (codemark ekf-slam and MRPT's "
@@ -301,12 +332,20 @@ int main(int argc, char** argv)
 				noises.push_back({"preset " + p, 0, 0, p});
 			}
 		}
+		for (const auto& d : datasets.getValue())
+		{
+			const auto eq = d.find('=');
+			if (eq == std::string::npos || eq == 0 || eq + 1 == d.size())
+				throw std::invalid_argument("--dataset: expected NAME=DIR, got '" + d + "'");
+			noises.push_back({d.substr(0, eq), 0, 0, "", d.substr(eq + 1)});
+		}
 		std::map<std::pair<std::string, std::string>, Result> results;
 		std::map<std::string, std::string> skipped;
 		std::map<std::pair<std::string, std::string>, SlamRow> slam_rows;
 		for (const auto& nz : noises)
 			for (int seed = 1; seed <= seeds.getValue(); ++seed)
 			{
+				if (!nz.dataset_dir.empty() && seed > 1) continue;	// one recorded run
 				sim::DatasetOptions o;
 				o.odometry_scale_error = 0.03;
 				o.seed = seed;
@@ -314,13 +353,21 @@ int main(int argc, char** argv)
 				o.render.blur_sigma_px = nz.blur_sigma_px;
 				if (!nz.preset.empty()) o.render.applyPreset(nz.preset);
 				const auto dir =
-					fs::path(work.getValue()) /
-					("seed" + std::to_string(seed) +
-					 (nz.preset.empty() ? "_noise" + std::to_string(int(nz.noise_sigma))
-										: "_" + nz.preset));
+					!nz.dataset_dir.empty()
+						? fs::path(nz.dataset_dir)
+						: fs::path(work.getValue()) /
+							  ("seed" + std::to_string(seed) +
+							   (nz.preset.empty() ? "_noise" + std::to_string(int(nz.noise_sigma))
+												  : "_" + nz.preset));
 				std::fprintf(stderr, "filters_sim: dataset %s\n", dir.c_str());
-				fs::create_directories(dir);
-				const auto ds = sim::writeDataset(o, dir.string(), false, {}, frames.getValue());
+				sim::DatasetSummary ds;
+				if (nz.dataset_dir.empty())
+				{
+					fs::create_directories(dir);
+					ds = sim::writeDataset(o, dir.string(), false, {}, frames.getValue());
+				}
+				else
+					ds = loadDataset(dir);
 				std::vector<RawlogStep> steps;
 				for (const auto& m : ms)
 				{
