@@ -37,7 +37,8 @@ struct PovrayArgs
 			  false, "own", "own|povray", cmd),
 		  ini("", "povray-ini",
 			  "POV-Ray renderer options file, section [povray] (keys of "
-			  "codemark::sim::PovrayOptions); the --light... flags below override it",
+			  "codemark::sim::PovrayOptions); the --light, --light-type, --light-gradient, --wall, "
+			  "--floor, --texture-seed and --povray-threads flags override it",
 			  false, "", "INI", cmd),
 		  light(
 			  "", "light", "POV-Ray: light level (default normal)", false, "", "dim|normal|bright",
