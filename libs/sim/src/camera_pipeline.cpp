@@ -395,8 +395,9 @@ cv::Mat jpegRoundTrip(const cv::Mat& img, int quality)
 	return cv::imdecode(buf, cv::IMREAD_COLOR);
 }
 
-cv::Mat cameraImage(cv::Mat& img, const RenderOptions& o, double cx, double cy, uint64_t seed)
+cv::Mat cameraImage(cv::Mat& linear, const RenderOptions& o, double cx, double cy, uint64_t seed)
 {
+	cv::Mat& img = linear;	// linear light until the transfer curve
 	CV_Assert(img.type() == CV_32FC3);
 	if (!o.range_draws.empty() || !o.choice_draws.empty())
 		throw std::invalid_argument("cameraImage: draw the options' ranges first (drawn(seed))");

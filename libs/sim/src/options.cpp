@@ -387,8 +387,11 @@ void RenderOptions::validate() const
 		bad("supersampling", "must be in 1..64, got " + std::to_string(supersampling));
 }
 
-void RenderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+void RenderOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
+	const auto& c = source;
+	const std::string& s = section;
 	// MRPT's readers take "abc" as 0 and "2px" as 2: check the numbers first.
 	requireIniNumbers(
 		c, s,
@@ -417,8 +420,11 @@ void RenderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 	validate();
 }
 
-void RenderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void RenderOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
+	auto& c = target;
+	const std::string& s = section;
 	c.write(
 		s, "background", std::string(backgroundName(background)), -1, -1,
 		"Flat, Textured or Cluttered");
