@@ -6,6 +6,7 @@
 #include <codemark/pose/consistency.h>
 #include <codemark/pose/general.h>
 #include <codemark/sim/dataset.h>
+#include <codemark/sim/camera_pipeline.h>
 #include <codemark/sim/render.h>
 
 extern "C"
@@ -124,9 +125,12 @@ struct TagRenderer
 	// Pinhole render (the camera's distortion is ignored: the survey uses an
 	// undistorted camera), area-sampled: 4 x 4 samples, 32 x 32 where they
 	// disagree (edge position error about 1/64 px), then blur and noise.
+	/** \a camera_stages: codemark's render options when a camera preset is
+	 * set (the tag then goes through the same camera pipeline), else null
+	 * and the tag gets \a blur and \a noise. */
 	cv::Mat render(
 		const CameraModel& cam, const CPose3D& landmark_T_camera, double blur, double noise,
-		uint64_t seed) const
+		uint64_t seed, const sim::RenderOptions* camera_stages = nullptr) const
 	{
 		const Eigen::Matrix3d R = landmark_T_camera.getRotationMatrix().asEigen();
 		const Eigen::Vector3d o(
@@ -164,6 +168,16 @@ struct TagRenderer
 				else
 					img.at<float>(v, u) = static_cast<float>(sum / 16);
 			}
+		if (camera_stages)
+		{
+			cv::Mat bgr;
+			cv::cvtColor(img, bgr, cv::COLOR_GRAY2BGR);
+			const cv::Mat out = sim::cameraImage(
+				bgr, camera_stages->drawn(seed), cam.cx(), cam.cy(), seed * 7919 + 17);
+			cv::Mat grey;
+			cv::cvtColor(out, grey, cv::COLOR_BGR2GRAY);
+			return grey;
+		}
 		if (blur > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), blur);
 		if (noise > 0)
 		{
@@ -335,8 +349,9 @@ std::vector<CellResult> runSurvey(
 			}
 			if (o.apriltag)
 			{
-				const cv::Mat grey =
-					tag.render(camera, landmark_T_camera, o.blur_sigma_px, o.noise_sigma, seed);
+				const cv::Mat grey = tag.render(
+					camera, landmark_T_camera, o.blur_sigma_px, o.noise_sigma, seed,
+					o.preset.empty() ? nullptr : &ro);
 				std::array<Eigen::Vector2d, 4> corners;
 				if (tagdet.detect(grey, img.truth[0].corners_px, corners))
 				{

@@ -46,9 +46,9 @@ struct SurveyOptions
 	 * of the paper's plain grey background; noise and blur as set. The
 	 * AprilTag renders keep the plain background. */
 	bool realistic = false;
-	/** Camera preset (docs/camera-pipeline.md) for codemark's renders,
-	 * applied after noise_sigma and blur_sigma_px (which it sets); "" =
-	 * none. The AprilTag renders keep the plain noise and blur. */
+	/** Camera preset (docs/camera-pipeline.md) of the renders, codemark's
+	 * and AprilTag's alike, in place of noise_sigma and blur_sigma_px;
+	 * "" = none. */
 	std::string preset;
 	/** Each render aims the camera off the landmark by a bearing drawn
 	 * uniformly within +-aim_jitter_rad and puts it higher or lower by up to
