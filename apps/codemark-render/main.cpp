@@ -16,6 +16,7 @@
 
 #include "errors.h"
 #include "povray_args.h"
+#include "preset.h"
 #include "progress.h"
 
 namespace
@@ -78,10 +79,13 @@ int main(int argc, char** argv)
 			"render options ini (keys of codemark::sim::RenderOptions: background = Flat|Textured|"
 			"Cluttered, distractors, noise_sigma, blur_sigma_px, motion_blur_px, jpeg_quality, "
 			"gain, "
-			"gradient, occlusion, ...). Keys not given keep the demo defaults: Cluttered (texture "
+			"gradient, occlusion, preset and the camera pipeline's stage keys: "
+			"docs/camera-pipeline.md). Keys not given keep the demo defaults: Cluttered (texture "
 			"with "
 			"6 distractors), noise_sigma 2, blur_sigma_px 0.8",
 			false, "", "RENDER.ini", cmd);
+		TCLAP::ValueArg<std::string> presetArg(
+			"", "preset", app::presetHelp(), false, "", "NAME", cmd);
 		TCLAP::ValueArg<std::string> sectionArg(
 			"", "section", "section of --options to read (default RENDER)", false, "RENDER", "NAME",
 			cmd);
@@ -126,18 +130,20 @@ int main(int argc, char** argv)
 		}
 
 		sim::RenderOptions options = demoOptions();
-		if (optionsArg.isSet())
+		if (optionsArg.isSet() || presetArg.isSet())
 		{
-			if (!std::ifstream(optionsArg.getValue()).good())
+			if (optionsArg.isSet() && !std::ifstream(optionsArg.getValue()).good())
 				throw std::runtime_error(
 					optionsArg.getValue() + ": cannot open render options file");
-			mrpt::config::CConfigFile cfg(optionsArg.getValue());
+			const auto cfg = app::iniWithPreset(
+				optionsArg.getValue(), sectionArg.getValue(), presetArg.getValue());
 			try
 			{
 				options.loadFromConfigFile(cfg, sectionArg.getValue());
 			}
 			catch (const std::exception&)
 			{
+				if (!optionsArg.isSet()) throw;
 				rethrowNamingIniFile(optionsArg.getValue());
 			}
 		}

@@ -11,6 +11,7 @@
 
 #include "errors.h"
 #include "povray_args.h"
+#include "preset.h"
 #include "progress.h"
 
 int main(int argc, char** argv)
@@ -42,22 +43,26 @@ int main(int argc, char** argv)
 			"s", "seed", "override [dataset] seed", false, 0, "N", cmd);
 		TCLAP::ValueArg<int> frames(
 			"", "max-frames", "stop after N images (0: the whole trajectory)", false, 0, "N", cmd);
+		TCLAP::ValueArg<std::string> preset(
+			"", "preset", codemark::app::presetHelp() + " in [render]", false, "", "NAME", cmd);
 		codemark::app::PovrayArgs pov(cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
 		codemark::sim::DatasetOptions opts;
-		if (!config.getValue().empty())
+		if (!config.getValue().empty() || preset.isSet())
 		{
-			if (!std::ifstream(config.getValue()).good())
+			if (!config.getValue().empty() && !std::ifstream(config.getValue()).good())
 				throw std::runtime_error(config.getValue() + ": cannot open config file");
-			mrpt::config::CConfigFile cfg(config.getValue());
+			const auto cfg =
+				codemark::app::iniWithPreset(config.getValue(), "render", preset.getValue());
 			try
 			{
 				opts.loadFromConfigFile(cfg, "");
 			}
 			catch (const std::exception&)
 			{
+				if (config.getValue().empty()) throw;
 				codemark::rethrowNamingIniFile(config.getValue());
 			}
 		}
