@@ -40,7 +40,8 @@ datasets=()
 if [[ $povray -eq 1 ]]; then
 	IFS=',' read -r -a names <<<"$presets"
 	for p in "${names[@]}"; do
-		bash "$ROOT/scripts/povray-sets.sh" --preset "$p" --no-single --out "$SETS" --build "$BUILD_DIR" >&2
+		bash "$ROOT/scripts/povray-sets.sh" --preset "$p" --no-single --room-formats actions \
+			--out "$SETS" --build "$BUILD_DIR" >&2
 		datasets+=(--dataset "POV-Ray room, preset $p=$SETS/$p/room/actions")
 	done
 fi

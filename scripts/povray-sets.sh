@@ -35,6 +35,8 @@ Options:
   --room-frames N       room-loop frames (default 0: the whole trajectory, 2 laps)
   --no-single           skip the single-landmark set
   --no-room             skip the room loop
+  --room-formats LIST   rawlog formats of the room loop: actions, obs-only or
+                        both, comma-separated (default actions,obs-only)
   -h, --help            this help
 EOF
 }
@@ -48,6 +50,7 @@ groups=""
 room_frames=0
 do_single=1
 do_room=1
+room_formats=actions,obs-only
 while [ $# -gt 0 ]; do
 	case "$1" in
 		--preset) preset=$2; shift 2 ;;
@@ -59,6 +62,7 @@ while [ $# -gt 0 ]; do
 		--room-frames) room_frames=$2; shift 2 ;;
 		--no-single) do_single=0; shift ;;
 		--no-room) do_room=0; shift ;;
+		--room-formats) room_formats=$2; shift 2 ;;
 		-h|--help) usage; exit 0 ;;
 		*) echo "$0: unknown argument '$1' (see --help)" >&2; exit 2 ;;
 	esac
@@ -197,7 +201,11 @@ seed = 1
 [render]
 background = Textured
 EOF
-	for fmt in actions obs-only; do
+	for fmt in ${room_formats//,/ }; do
+		if [ "$fmt" != actions ] && [ "$fmt" != obs-only ]; then
+			echo "$0: --room-formats: unknown format '$fmt' (actions or obs-only)" >&2
+			exit 2
+		fi
 		flag=()
 		[ "$fmt" = obs-only ] && flag=(--obs-only)
 		echo "povray-sets: room loop ($fmt format)"
