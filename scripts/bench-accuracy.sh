@@ -9,14 +9,17 @@
 # a scratch folder instead.
 #
 # Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
-#        [--presets LIST [--renders N]]
+#        [--presets LIST [--renders N] [--renderer own|povray]]
 # --presets LIST (comma-separated camera presets, docs/camera-pipeline.md)
 # runs, instead of the above, the calibration tool and the accuracy map
 # once per preset (codemark's renders through that camera; AprilTag's keep
 # noise 2 and blur 0.8) and writes
 # apps/codemark-accuracy-map/results/presets/NAME/ (summary.txt, cells.csv,
 # heat maps, calibration.txt); --renders sets the map's renders per cell
-# (default 4).
+# (default 4); --renderer povray renders the map's frames with POV-Ray
+# (docs/povray.md; cached, so the other presets reuse the first one's
+# renders) into apps/codemark-accuracy-map/results/presets-povray/NAME/
+# (the map only: the calibration tool renders with the project's renderer).
 # Environment: BUILD_DIR (default build-bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,12 +27,14 @@ build_dir="${BUILD_DIR:-build-bench}"
 quick=0
 presets=""
 renders=4
+renderer=own
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build_dir="$2"; shift 2 ;;
     --quick) quick=1; shift ;;
     --presets) presets="$2"; shift 2 ;;
     --renders) renders="$2"; shift 2 ;;
+    --renderer) renderer="$2"; shift 2 ;;
     *) echo "bench-accuracy.sh: unknown option $1" >&2; exit 1 ;;
   esac
 done
@@ -40,6 +45,13 @@ map="$build_dir/apps/codemark-accuracy-map/codemark-accuracy-map"
 if [[ -n "$presets" ]]; then
   IFS=',' read -r -a names <<<"$presets"
   for p in "${names[@]}"; do
+    if [[ "$renderer" == povray ]]; then
+      dir="apps/codemark-accuracy-map/results/presets-povray/$p"
+      mkdir -p "$dir"
+      echo "== preset $p: accuracy map rendered by POV-Ray ($renders renders a cell)"
+      "$map" --out "$dir" --renders "$renders" --preset "$p" --renderer povray
+      continue
+    fi
     dir="apps/codemark-accuracy-map/results/presets/$p"
     mkdir -p "$dir"
     echo "== preset $p: C_P calibration data (realistic scenes) and accuracy map ($renders renders a cell)"

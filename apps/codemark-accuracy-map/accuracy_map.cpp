@@ -323,7 +323,8 @@ std::vector<CellResult> runSurvey(
 				lm, c.distance_m, c.angle_deg * M_PI / 180, height, bearing);
 			const CPose3D landmark_T_camera = scene.world_T_camera - lm.world_T_landmark();
 			const SightingTruth truth = sightingTruth(landmark_T_camera);
-			const sim::Render img = sim::render(scene, ro, seed);
+			const sim::Render img =
+				o.renderer ? o.renderer(scene, ro, seed) : sim::render(scene, ro, seed);
 			++c.renders;
 			const auto res = detect::detect(img.image, camera, g, dopt);
 			for (const auto& dl : res.landmarks)
@@ -551,7 +552,7 @@ std::string writeResults(
 		{"2 to 5 m, all angles", 2.0 + 1e-9, 5.0 + 1e-9, 90}};
 	std::ostringstream s;
 	s << "# codemark accuracy map: " << cells.size() << " cells of " << fmt(o.cell_m, 2) << " m, "
-	  << o.renders_per_cell << " renders each, "
+	  << o.renders_per_cell << " renders each by " << o.source_label << ", "
 	  << (o.preset.empty()
 			  ? "noise " + fmt(o.noise_sigma, 1) + ", blur " + fmt(o.blur_sigma_px, 2) + " px"
 			  : "camera preset " + o.preset)

@@ -12,6 +12,7 @@
 #include <codemark/detect/options.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/pose/measurement.h>
+#include <codemark/sim/render.h>
 
 #include <array>
 #include <cstdint>
@@ -50,6 +51,11 @@ struct SurveyOptions
 	 * and AprilTag's alike, in place of noise_sigma and blur_sigma_px;
 	 * "" = none. */
 	std::string preset;
+	/** The image source of codemark's renders: empty = sim::render (the
+	 * project's renderer), or e.g. sim::povrayRenderer(); \a source_label
+	 * names it in the summary. */
+	sim::Renderer renderer;
+	std::string source_label = "the project's renderer";
 	/** Each render aims the camera off the landmark by a bearing drawn
 	 * uniformly within +-aim_jitter_rad and puts it higher or lower by up to
 	 * height_jitter_m (the cell fixes the camera's planar position): a robot

@@ -10,6 +10,7 @@
 #include <codemark/pipeline/pipeline.h>
 #include <codemark/sim/render.h>
 
+#include "../common/povray_args.h"
 #include "../common/progress.h"
 #include "accuracy_map.h"
 
@@ -87,6 +88,7 @@ int main(int argc, char** argv)
 			"Camera preset of codemark's renders (linear, machine-vision, webcam, phone, family: "
 			"docs/camera-pipeline.md), in place of --noise and --blur.",
 			false, "", "NAME", cmd);
+		codemark::app::PovrayArgs pov(cmd);
 		TCLAP::SwitchArg realistic_arg(
 			"", "realistic",
 			"Render codemark's landmark in the realistic scene the C_P calibration was fitted "
@@ -146,6 +148,11 @@ int main(int argc, char** argv)
 				"--fold-ambiguity and --no-fold-ambiguity exclude each other");
 		o.pose.fold_ambiguity = !no_fold_arg.getValue();
 		o.realistic = realistic_arg.getValue();
+		if (pov.povray())
+		{
+			o.renderer = pov.make();
+			o.source_label = "POV-Ray (docs/povray.md)";
+		}
 		if (preset_arg.isSet())
 		{
 			(void)codemark::sim::RenderOptions::presetKeys(preset_arg.getValue());
