@@ -148,8 +148,11 @@ void PovrayOptions::validate() const
 	if (executable.empty()) bad("executable", "must not be empty");
 }
 
-void PovrayOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+void PovrayOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
+	const auto& c = source;
+	const std::string& s = section;
 	requireIniNumbers(
 		c, s,
 		{"light_scale", "ambient_share", "light_gradient", "lamp_distance_m", "lamp_height_m",
@@ -179,8 +182,11 @@ void PovrayOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 	validate();
 }
 
-void PovrayOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void PovrayOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
+	auto& c = target;
+	const std::string& s = section;
 	c.write(s, "light", lightLevelName(light));
 	c.write(s, "light_scale", light_scale);
 	c.write(s, "light_type", lightTypeName(light_type));
@@ -742,7 +748,7 @@ std::string findProgram(const std::string& exe)
 	std::string dir;
 	while (std::getline(dirs, dir, ':'))
 	{
-		const std::string p = (dir.empty() ? std::string(".") : dir) + "/" + exe;
+		std::string p = (dir.empty() ? std::string(".") : dir) + "/" + exe;
 		if (::access(p.c_str(), X_OK) == 0) return p;
 	}
 	return {};
@@ -765,6 +771,7 @@ std::string lastLines(const std::string& file, size_t n)
 int runIn(const std::string& dir, const std::vector<std::string>& args, const std::string& log)
 {
 	std::vector<char*> argv;
+	argv.reserve(args.size() + 1);
 	for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
 	argv.push_back(nullptr);
 	const pid_t pid = ::fork();
