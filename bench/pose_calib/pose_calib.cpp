@@ -15,6 +15,7 @@
 #include <codemark/pose/measurement.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/sim/dataset.h>
+#include <codemark/sim/povray.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
 #include <tclap/CmdLine.h>
@@ -164,6 +165,11 @@ int main(int argc, char** argv)
 			"wall, light gradient, noise 2, blur 0.8) instead of the accuracy map's flat "
 			"background.",
 			cmd, false);
+		TCLAP::ValueArg<std::string> renderer_arg(
+			"", "renderer",
+			"own (default): the project's renderer; povray: POV-Ray 3.7 with its default "
+			"options (docs/povray.md; cached renders)",
+			false, "own", "own|povray", cmd);
 		TCLAP::ValueArg<std::string> preset_arg(
 			"", "preset",
 			"Camera preset of the renders (docs/camera-pipeline.md), applied after --realistic "
@@ -204,6 +210,12 @@ int main(int argc, char** argv)
 			false, 0, "S", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
+		if (renderer_arg.getValue() != "own" && renderer_arg.getValue() != "povray")
+			throw std::invalid_argument(
+				"--renderer must be own or povray, got '" + renderer_arg.getValue() + "'");
+		const sim::Renderer renderer = renderer_arg.getValue() == "povray"
+										   ? sim::povrayRenderer(sim::PovrayOptions())
+										   : sim::Renderer(sim::render);
 		if (n_arg.getValue() < 1 || !(dmin_arg.getValue() > 0) ||
 			!(dmax_arg.getValue() > dmin_arg.getValue()) || !(amax_arg.getValue() >= 0) ||
 			!(amax_arg.getValue() < 90) || !(bearing_arg.getValue() >= 0) ||
@@ -257,7 +269,7 @@ int main(int argc, char** argv)
 				if (U(rng) < level_arg.getValue()) height = 0;
 				scene.world_T_camera =
 					sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
-				const sim::Render img = sim::render(scene, r, seed_arg.getValue() * 100003 + i);
+				const sim::Render img = renderer(scene, r, seed_arg.getValue() * 100003 + i);
 				if (!img.truth[0].fully_visible) continue;
 				const auto res = detect::detect(img.image, scene.camera, g, dopt);
 				bool found = false;
