@@ -67,6 +67,12 @@ while [ $# -gt 0 ]; do
 		*) echo "$0: unknown argument '$1' (see --help)" >&2; exit 2 ;;
 	esac
 done
+for fmt in ${room_formats//,/ }; do
+	if [ "$fmt" != actions ] && [ "$fmt" != obs-only ]; then
+		echo "$0: --room-formats: unknown format '$fmt' (actions or obs-only)" >&2
+		exit 2
+	fi
+done
 if [ -z "$preset" ]; then
 	echo "$0: --preset NAME is required (see --help)" >&2
 	exit 2
@@ -202,10 +208,6 @@ seed = 1
 background = Textured
 EOF
 	for fmt in ${room_formats//,/ }; do
-		if [ "$fmt" != actions ] && [ "$fmt" != obs-only ]; then
-			echo "$0: --room-formats: unknown format '$fmt' (actions or obs-only)" >&2
-			exit 2
-		fi
 		flag=()
 		[ "$fmt" = obs-only ] && flag=(--obs-only)
 		echo "povray-sets: room loop ($fmt format)"
