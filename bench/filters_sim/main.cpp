@@ -6,11 +6,11 @@
 // scripts/bench-filters.sh). Images are detected once per dataset and every
 // filter runs on the same steps.
 #include <codemark/filters/ekf.h>
+#include <codemark/filters/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
-#include <codemark/landmark/text.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/config/CConfigFile.h>
@@ -22,7 +22,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <random>
@@ -56,19 +55,12 @@ sim::DatasetSummary loadDataset(const fs::path& dir)
 {
 	sim::DatasetSummary ds;
 	ds.map = LandmarkMap::load((dir / "map.txt").string());
-	const fs::path gt = dir / "gt_path.txt";
-	std::ifstream in(gt);
-	if (!in) throw std::runtime_error(gt.string() + ": cannot open");
-	std::string line;
-	for (int n = 1; std::getline(in, line); ++n)
-	{
-		const auto v = parseNumberRow(line, gt.string(), n);
-		if (v.empty()) continue;
-		if (v.size() != 4)
-			throw std::runtime_error(
-				gt.string() + ":" + std::to_string(n) + ": expected 'timestamp x y yaw'");
-		ds.ground_truth.push_back({v[0], mrpt::poses::CPose2D(v[1], v[2], v[3])});
-	}
+	const std::string gt_path = (dir / "gt_path.txt").string();
+	const auto gt = filters::GroundTruth::load(gt_path);
+	if (gt.form() != filters::GroundTruth::Form::Timestamped)
+		throw std::runtime_error(gt_path + ": expected 'timestamp x y yaw' rows");
+	for (size_t i = 0; i < gt.size(); ++i)
+		ds.ground_truth.push_back({gt.times()[i], gt.poses()[i]});
 	ds.frames = static_cast<int>(ds.ground_truth.size());
 	return ds;
 }
@@ -321,7 +313,7 @@ int main(int argc, char** argv)
 			for (std::string m; std::getline(ss, m, ',');) ms.push_back(m);
 		}
 		std::vector<Noise> noises = {
-			{"noise 2, blur 0.8 px", 2.0, 0.8, ""}, {"noise 6, blur 1.2 px", 6.0, 1.2, ""}};
+			{"noise 2, blur 0.8 px", 2.0, 0.8, "", ""}, {"noise 6, blur 1.2 px", 6.0, 1.2, "", ""}};
 		if (presets.isSet())
 		{
 			noises.clear();
@@ -329,7 +321,7 @@ int main(int argc, char** argv)
 			for (std::string p; std::getline(ss, p, ',');)
 			{
 				(void)sim::RenderOptions::presetKeys(p);  // an unknown name throws
-				noises.push_back({"preset " + p, 0, 0, p});
+				noises.push_back({"preset " + p, 0, 0, p, ""});
 			}
 		}
 		for (const auto& d : datasets.getValue())

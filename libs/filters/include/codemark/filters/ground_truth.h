@@ -48,6 +48,8 @@ class GroundTruth
 	std::size_t size() const { return poses_.size(); }
 	/** Every pose of the file in order (for plots). */
 	const std::vector<mrpt::poses::CPose2D>& poses() const { return poses_; }
+	/** The rows' timestamps [UNIX s], one per pose; empty for an MRPT path. */
+	const std::vector<double>& times() const { return times_; }
 
    private:
 	Form form_ = Form::Timestamped;
