@@ -323,8 +323,7 @@ std::vector<CellResult> runSurvey(
 				lm, c.distance_m, c.angle_deg * M_PI / 180, height, bearing);
 			const CPose3D landmark_T_camera = scene.world_T_camera - lm.world_T_landmark();
 			const SightingTruth truth = sightingTruth(landmark_T_camera);
-			const sim::Render img =
-				o.renderer ? o.renderer(scene, ro, seed) : sim::render(scene, ro, seed);
+			const sim::Render img = o.renderer(scene, ro, seed);
 			++c.renders;
 			const auto res = detect::detect(img.image, camera, g, dopt);
 			for (const auto& dl : res.landmarks)

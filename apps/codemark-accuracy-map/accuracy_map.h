@@ -51,10 +51,10 @@ struct SurveyOptions
 	 * and AprilTag's alike, in place of noise_sigma and blur_sigma_px;
 	 * "" = none. */
 	std::string preset;
-	/** The image source of codemark's renders: empty = sim::render (the
-	 * project's renderer), or e.g. sim::povrayRenderer(); \a source_label
-	 * names it in the summary. */
-	sim::Renderer renderer;
+	/** The image source of codemark's renders: sim::render (the project's
+	 * renderer), or e.g. sim::povrayRenderer(); \a source_label names it in
+	 * the summary. */
+	sim::Renderer renderer = sim::render;
 	std::string source_label = "the project's renderer";
 	/** Each render aims the camera off the landmark by a bearing drawn
 	 * uniformly within +-aim_jitter_rad and puts it higher or lower by up to

@@ -20,6 +20,8 @@
 #include <mrpt/math/distributions.h>
 #include <tclap/CmdLine.h>
 
+#include "progress.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <atomic>
@@ -472,7 +474,8 @@ int main(int argc, char** argv)
 		std::vector<Run> runs;
 		const auto t0 = std::chrono::steady_clock::now();
 		const size_t total = sources.size() * presets.size() * set.size();
-		size_t done = 0;
+		long done = 0;
+		app::ProgressBar bar("codemark-bench-camera", !quietArg.getValue());
 		for (const auto& source : sources)
 		{
 			for (const auto& preset : presets)
@@ -516,11 +519,7 @@ int main(int argc, char** argv)
 									next = set.size();
 								}
 								std::lock_guard<std::mutex> lock(progress_mutex);
-								++done;
-								if (!quietArg.getValue() && (done % 10 == 0 || done == total))
-									std::cerr << "\rcodemark-bench-camera: " << done << "/" << total
-											  << " (" << 100 * done / total << "%) " << source
-											  << " " << preset << "        " << std::flush;
+								bar.update(++done, static_cast<long>(total));
 							}
 						});
 				for (auto& t : pool) t.join();
@@ -528,7 +527,7 @@ int main(int argc, char** argv)
 				runs.push_back(std::move(run));
 			}
 		}
-		if (!quietArg.getValue()) std::cerr << "\n";
+		bar.finish();
 		const double secs =
 			std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
