@@ -17,6 +17,7 @@
 #include <codemark/sim/povray.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
+#include <opencv2/imgcodecs.hpp>
 #include <mrpt/math/distributions.h>
 #include <tclap/CmdLine.h>
 
@@ -441,6 +442,16 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> threadsArg(
 			"j", "threads", "worker threads (default 2)", false, 2, "N", cmd);
 		TCLAP::SwitchArg quietArg("q", "quiet", "no progress on stderr", cmd);
+		TCLAP::ValueArg<std::string> configArg(
+			"", "config",
+			"detector parameters: an ini file with a [DETECTOR] section (default: the shipped "
+			"defaults)",
+			false, "", "detector.ini", cmd);
+		TCLAP::ValueArg<std::string> missesArg(
+			"", "misses",
+			"folder (created when missing) that receives the image of every eligible frame "
+			"not detected, as SOURCE-PRESET-GROUP-INDEX.png",
+			false, "", "DIR", cmd);
 		cmd.parse(argc, argv);
 
 		auto sources = splitList(sourceArg.getValue());
@@ -469,7 +480,8 @@ int main(int argc, char** argv)
 			}
 		const CameraModel& camera = base.camera;
 		const auto set = loadSet(set_dir, base);
-		const pipeline::PipelineOptions popt;
+		pipeline::PipelineOptions popt;
+		if (configArg.isSet()) popt.detector = detect::DetectorOptions::load(configArg.getValue());
 
 		std::vector<Run> runs;
 		const auto t0 = std::chrono::steady_clock::now();
@@ -511,6 +523,17 @@ int main(int argc, char** argv)
 										r.truth = sim::groundTruth(scene);
 									}
 									run.frames[i] = evaluate(f, r, camera, popt, id);
+									if (missesArg.isSet() && run.frames[i].eligible &&
+										!run.frames[i].detected)
+									{
+										fs::create_directories(missesArg.getValue());
+										const std::string name = source + "-" + preset + "-" +
+																 f.group + "-" +
+																 std::to_string(f.index) + ".png";
+										cv::imwrite(
+											(fs::path(missesArg.getValue()) / name).string(),
+											r.image);
+									}
 								}
 								catch (...)
 								{

@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,4 +111,55 @@ TEST(Options, ShippedIniHoldsTheDefaults)
 	f.getAllKeys("DETECTOR", keys_file);
 	b.getAllKeys("DETECTOR", keys_all);
 	EXPECT_EQ(keys_file.size(), keys_all.size());
+}
+
+// A key the detector does not read is refused with its name, the file and
+// its line: a misspelt key would otherwise leave its default in force.
+TEST(Options, UnknownKeysAreRefusedWithFileAndLine)
+{
+	mrpt::config::CConfigFileMemory cfg;
+	cfg.write("D", "segmentation.min_saturaton", 0.3);
+	DetectorOptions o;
+	try
+	{
+		o.loadFromConfigFile(cfg, "D");
+		FAIL() << "an unknown key was accepted";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("'segmentation.min_saturaton'"), std::string::npos)
+			<< e.what();
+	}
+	const std::string path = testing::TempDir() + "codemark_unknown_key.ini";
+	{
+		std::ofstream f(path);
+		f << "[OTHER]\nsubpixel.no_such_option = 1\n[DETECTOR]\n# comment\n"
+			 "segmentation.step_px = 2\n  subpixel.no_such_option = true\n";
+	}
+	try
+	{
+		(void)DetectorOptions::load(path);
+		FAIL() << "an unknown key in a file was accepted";
+	}
+	catch (const std::runtime_error& e)
+	{
+		const std::string what = e.what();
+		EXPECT_NE(what.find(path + ":6:"), std::string::npos) << what;
+		EXPECT_NE(what.find("subpixel.no_such_option"), std::string::npos) << what;
+	}
+	// A value of the wrong type is located on its line too.
+	{
+		std::ofstream f(path);
+		f << "[DETECTOR]\n\nsegmentation.step_px = 2x\n";
+	}
+	try
+	{
+		(void)DetectorOptions::load(path);
+		FAIL() << "a bad value was accepted";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(path + ":3:"), std::string::npos) << e.what();
+	}
+	std::remove(path.c_str());
 }

@@ -141,6 +141,19 @@ std::optional<CodeReading> readCode(
 			r.margin = std::min(r.margin, std::abs(*g - thr));
 		}
 	if (r.margin < p.min_margin * contrast) return std::nullopt;
+	// The frame and the black cells are the same ink: the frame's G must
+	// lie near the black cells' (the centre one at least), whatever the
+	// camera's transfer curve does to both.
+	double cells_g = 0;
+	int black_cells = 0;
+	for (int k = 0; k < 9; ++k)
+		if (r.cells[k / 3][k % 3])
+		{
+			cells_g += r.cell_g[k];
+			++black_cells;
+		}
+	cells_g /= std::max(1, black_cells);
+	if (r.black_g - cells_g > p.max_frame_cell_ratio * (r.green_g - cells_g)) return std::nullopt;
 	const auto id = decodeCells(r.cells);
 	if (!id) return std::nullopt;
 	r.id = *id;

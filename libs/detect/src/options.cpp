@@ -3,11 +3,14 @@
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace codemark::detect
 {
@@ -107,8 +110,46 @@ void forEachField(Options& o, F&& f)
 	f("code.min_contrast", o.code.min_contrast);
 	f("code.max_black_ratio", o.code.max_black_ratio);
 	f("code.max_side_black_ratio", o.code.max_side_black_ratio);
+	f("code.max_frame_cell_ratio", o.code.max_frame_cell_ratio);
 	f("code.min_margin", o.code.min_margin);
 	f("code.border_px", o.code.border_px);
+}
+
+/** ":LINE" of the line in \a section of the ini file \a path that sets the
+ * key a load error \a what names first ('key' quoted, or "key = ..."),
+ * or "" when it cannot be found. */
+std::string lineOf(const std::string& path, const std::string& section, const std::string& what)
+{
+	std::string key;
+	const auto q = what.find('\'');
+	if (q != std::string::npos && what.compare(0, 12, "unknown key ") == 0)
+		key = what.substr(q + 1, what.find('\'', q + 1) - q - 1);
+	else
+		key = what.substr(0, what.find_first_of(" ="));
+	if (key.empty()) return "";
+	std::ifstream in(path);
+	std::string line;
+	bool inside = false;
+	for (int n = 1; std::getline(in, line); ++n)
+	{
+		const auto first = line.find_first_not_of(" \t");
+		if (first == std::string::npos) continue;
+		if (line[first] == '[')
+		{
+			const auto end = line.find(']', first);
+			std::string name = line.substr(first + 1, end - first - 1);
+			inside = name.size() == section.size() &&
+					 std::equal(
+						 name.begin(), name.end(), section.begin(), [](char a, char b)
+						 { return std::tolower(a) == std::tolower(b); });
+			continue;
+		}
+		if (inside && line.compare(first, key.size(), key) == 0 &&
+			line.find_first_not_of(" \t", first + key.size()) != std::string::npos &&
+			line[line.find_first_not_of(" \t", first + key.size())] == '=')
+			return ":" + std::to_string(n);
+	}
+	return "";
 }
 }  // namespace
 
@@ -174,6 +215,9 @@ void DetectorOptions::validate() const
 	require(
 		code.max_side_black_ratio >= code.max_black_ratio && code.max_side_black_ratio < 1,
 		"code.max_side_black_ratio", "in [max_black_ratio, 1)");
+	require(
+		code.max_frame_cell_ratio > 0 && code.max_frame_cell_ratio <= 1,
+		"code.max_frame_cell_ratio", "in (0, 1]");
 	require(code.min_margin >= 0 && code.min_margin < 0.5, "code.min_margin", "in [0, 0.5)");
 	require(std::isfinite(code.border_px), "code.border_px", "finite");
 }
@@ -181,6 +225,19 @@ void DetectorOptions::validate() const
 void DetectorOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
+	// A key the detector does not read (a misspelling, an option that no
+	// longer exists) is refused, never silently ignored.
+	std::vector<std::string> keys;
+	c.getAllKeys(s, keys);
+	for (const auto& k : keys)
+	{
+		bool known = false;
+		forEachField(*this, [&](const char* key, const auto&) { known = known || k == key; });
+		if (!known)
+			throw std::invalid_argument(
+				"unknown key '" + k +
+				"' (not a detector option; share/codemark/detector.ini lists them all)");
+	}
 	forEachField(*this, [&](const char* key, auto& v) { readKey(c, s, key, v); });
 	validate();
 }
@@ -206,7 +263,7 @@ DetectorOptions DetectorOptions::load(const std::string& path, const std::string
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + ": [" + section + "]: " + e.what());
+		throw std::runtime_error(path + lineOf(path, section, e.what()) + ": [" + section + "]: " + e.what());
 	}
 	return o;
 }

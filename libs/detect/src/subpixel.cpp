@@ -694,14 +694,16 @@ std::optional<RefinedQuad> refineQuadrangle(
 			{
 				const int* gp = g_prof.data() + j * n;
 				const int* rbp = rb_prof.data() + j * n;
-				// The edge must have the green fill just inside it (G above
-				// R + B two pixels inwards): the sheet's edge against a
-				// darker wall rises inwards too, a frame width and a margin
-				// outside.
+				// The edge must have the green fill just inside it (G two
+				// pixels inwards above the mean of R and B by at least a
+				// quarter of G: a printed green through any transfer curve
+				// is, white paper and grey walls are not): the sheet's edge
+				// against a darker wall rises inwards too, a frame width and
+				// a margin outside.
 				const auto greenInside = [&](double e)
 				{
 					const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
-					return gp[i] > -rbp[i];
+					return 3 * gp[i] > -2 * rbp[i];
 				};
 				const auto locate = [&](int l, int h) -> std::optional<double>
 				{

@@ -32,8 +32,10 @@ struct SegmentationParams
 	double hue_min_deg = 80;
 	double hue_max_deg = 160;
 	/** Saturation floor S = 1 - min(R,G,B) / I, 0..1: rejects greys, whites
-	 * and pastel greenish surfaces. */
-	double min_saturation = 0.45;
+	 * and pastel greenish surfaces. Office inkjet and laser greens read
+	 * S = 0.4-0.6 under daylight, a white balance off by 25% takes up to
+	 * 0.12 of that, and a camera's transfer curve lowers it further. */
+	double min_saturation = 0.25;
 };
 
 /** Stage 3 of the paper: N4-connected components of the mask, compactness
@@ -64,9 +66,12 @@ struct ComponentParams
 	 * component's box, the darkest G (median of the three) must be dark. The
 	 * mean of the two darkest sides must stay below max_frame_ratio times the
 	 * fill's G, and every side below max_side_frame_ratio times it (a side
-	 * under 2 px wide at 5 m and 60 deg does not reach black). 1 disables. */
-	double max_frame_ratio = 0.4;
-	double max_side_frame_ratio = 0.7;
+	 * under 2 px wide at 5 m and 60 deg does not reach black). The ratios
+	 * are of encoded grey levels: printed black against a printed green is
+	 * about 0.2 in linear light, which an sRGB or gamma 2.6 curve lifts to
+	 * 0.5-0.55. 1 disables. */
+	double max_frame_ratio = 0.7;
+	double max_side_frame_ratio = 0.9;
 	/** Centre evidence: the code board's centre cell is always black, so a
 	 * landmark's fill component has a hole at its centre. When the centre
 	 * cell is surely large enough to open that hole in the mask (its
@@ -221,13 +226,22 @@ struct CodeParams
 	/** Smallest contrast G(green) - G(black) [grey levels]. */
 	double min_contrast = 20;
 	/** The frame's G (mean of its two darkest sides) must stay below this
-	 * fraction of the fill's: a black frame, not a grey or coloured one
-	 * (printed black under the spec's colours: ~0.1). */
-	double max_black_ratio = 0.35;
+	 * fraction of the fill's: a black frame, not a grey or coloured one.
+	 * Encoded grey levels: printed black against a printed green is about
+	 * 0.1-0.2 in linear light and up to 0.55 through a camera's transfer
+	 * curve (ComponentParams::max_frame_ratio). */
+	double max_black_ratio = 0.7;
 	/** Each side of the frame must stay below this fraction of the fill's G
 	 * next to it (looser: at 60 deg and 5 m a side is under 2 px wide and
 	 * blurs towards its neighbours). */
-	double max_side_black_ratio = 0.75;
+	double max_side_black_ratio = 0.9;
+	/** The frame and the black code cells are one ink: the frame's G (two
+	 * darkest sides) may exceed the black cells' mean G by at most this
+	 * fraction of the fill's G above that mean. Independent of the
+	 * camera's transfer curve, which maps equal levels to equal levels.
+	 * Landmarks read up to 0.25 through every camera preset, where a thin
+	 * frame blurs towards the fill; a grey surround reads 0.5. */
+	double max_frame_cell_ratio = 0.35;
 	/** Each cell's distance to the threshold must be at least this fraction
 	 * of the contrast (else ambiguous: rejected). */
 	double min_margin = 0.15;
