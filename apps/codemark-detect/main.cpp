@@ -3,6 +3,7 @@
  * and videos, and prints one JSON object per image (landmark-spec.md
  * section 5). Parses the command line and calls codemark::detect::detect().
  */
+#include <codemark/detect/colour.h>
 #include <codemark/detect/detector.h>
 #include <codemark/detect/json.h>
 #include <codemark/pipeline/pipeline.h>
@@ -79,7 +80,46 @@ struct Runner
 	/** Pose options: the pipeline's, calibrated for this detector. */
 	pose::PoseOptions pose = pipeline::detectorCalibratedPoseOptions();
 	std::string draw_dir, debug_dir;
+	bool colour_report = false;
 	int failures = 0;
+
+	/** The colour report's readable table of one detection, on stderr. */
+	void printColourTable(const std::string& name, int id, const detect::ColourReport& c) const
+	{
+		const auto& s = options.segmentation;
+		char buf[512];
+		std::cerr << "codemark-detect: colours of landmark " << id << " in " << name << "\n";
+		std::cerr << "            R      G      B   hue[deg]  sat      I\n";
+		for (const auto& [label, m] :
+			 {std::pair<const char*, const detect::MeasuredColour&>{"fill ", c.fill},
+			  {"frame", c.frame}})
+		{
+			std::snprintf(
+				buf, sizeof buf, "  %s %6.1f %6.1f %6.1f %8.1f %6.3f %6.1f\n", label, m.r, m.g, m.b,
+				m.hue_deg, m.saturation, m.intensity);
+			std::cerr << buf;
+		}
+		const auto row = [&](const char* what, double margin, const char* rule)
+		{
+			std::snprintf(
+				buf, sizeof buf, "  margin %-12s %+8.3f  (%s)%s\n", what, margin, rule,
+				margin < 0 ? "  FAILS" : "");
+			std::cerr << buf;
+		};
+		char rule[96];
+		std::snprintf(rule, sizeof rule, "fill I >= %g", s.min_intensity);
+		row("intensity", c.margin_intensity, rule);
+		std::snprintf(rule, sizeof rule, "fill S >= %g", s.min_saturation);
+		row("saturation", c.margin_saturation, rule);
+		std::snprintf(rule, sizeof rule, "fill hue >= %g deg", s.hue_min_deg);
+		row("hue min", c.margin_hue_min_deg, rule);
+		std::snprintf(rule, sizeof rule, "fill hue <= %g deg", s.hue_max_deg);
+		row("hue max", c.margin_hue_max_deg, rule);
+		std::snprintf(rule, sizeof rule, "frame G / fill G <= %g", options.code.max_black_ratio);
+		row("black ratio", c.margin_black_ratio, rule);
+		std::snprintf(rule, sizeof rule, "fill G - frame G >= %g", options.code.min_contrast);
+		row("contrast", c.margin_contrast, rule);
+	}
 
 	void fail(const std::string& name, const std::string& why)
 	{
@@ -148,6 +188,12 @@ struct Runner
 			catch (const std::invalid_argument&)
 			{
 				// Degenerate corners: the detection without a measurement.
+			}
+			if (colour_report)
+			{
+				const auto c = detect::colourReport(img, d.detection, camera, geometry, options);
+				f.emplace_back("fill_colour", detect::colourReportJson(c));
+				printColourTable(name, d.detection.id, c);
 			}
 			extra.push_back(std::move(f));
 		}
@@ -287,6 +333,16 @@ int main(int argc, char** argv)
 			"Folder (created when missing) that receives per image a sub-folder with the "
 			"detector's stage images: colour mask, components, edgels, fitted lines, overlay.",
 			false, "", "DIR", cmd);
+		TCLAP::SwitchArg colour_arg(
+			"", "colour-report",
+			"Measure each detected landmark's fill and frame colours: adds \"fill_colour\" to "
+			"each detection ({\"fill\", \"frame\": {\"rgb\", \"hue_deg\", \"saturation\", "
+			"\"intensity\", \"samples\"}, \"margins\": {\"intensity\", \"saturation\", "
+			"\"hue_min_deg\", \"hue_max_deg\", \"black_ratio\", \"contrast\"}}; a margin is "
+			"the distance to the detector's threshold, negative where that test fails) and "
+			"prints a table per landmark on stderr. Check a print under your light with it "
+			"before recording.",
+			cmd);
 		TCLAP::UnlabeledMultiArg<std::string> inputs_arg(
 			"inputs",
 			"Image files, folders (every image inside, sorted by name; not recursive) or video "
@@ -327,6 +383,7 @@ int main(int argc, char** argv)
 		}
 		r.draw_dir = draw_arg.getValue();
 		r.debug_dir = debug_arg.getValue();
+		r.colour_report = colour_arg.getValue();
 		if (!r.draw_dir.empty()) fs::create_directories(r.draw_dir);
 		if (!r.debug_dir.empty()) fs::create_directories(r.debug_dir);
 		// Warm up once, so that the first image's time_ms does not carry

@@ -140,8 +140,8 @@ std::string lineOf(const std::string& path, const std::string& section, const st
 			std::string name = line.substr(first + 1, end - first - 1);
 			inside = name.size() == section.size() &&
 					 std::equal(
-						 name.begin(), name.end(), section.begin(), [](char a, char b)
-						 { return std::tolower(a) == std::tolower(b); });
+						 name.begin(), name.end(), section.begin(),
+						 [](char a, char b) { return std::tolower(a) == std::tolower(b); });
 			continue;
 		}
 		if (inside && line.compare(first, key.size(), key) == 0 &&
@@ -263,7 +263,8 @@ DetectorOptions DetectorOptions::load(const std::string& path, const std::string
 	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(path + lineOf(path, section, e.what()) + ": [" + section + "]: " + e.what());
+		throw std::runtime_error(
+			path + lineOf(path, section, e.what()) + ": [" + section + "]: " + e.what());
 	}
 	return o;
 }
