@@ -223,12 +223,12 @@ void DetectorOptions::validate() const
 }
 
 void DetectorOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
 	// A key the detector does not read (a misspelling, an option that no
 	// longer exists) is refused, never silently ignored.
 	std::vector<std::string> keys;
-	c.getAllKeys(s, keys);
+	source.getAllKeys(section, keys);
 	for (const auto& k : keys)
 	{
 		bool known = false;
@@ -238,15 +238,16 @@ void DetectorOptions::loadFromConfigFile(
 				"unknown key '" + k +
 				"' (not a detector option; share/codemark/detector.ini lists them all)");
 	}
-	forEachField(*this, [&](const char* key, auto& v) { readKey(c, s, key, v); });
+	forEachField(*this, [&](const char* key, auto& v) { readKey(source, section, key, v); });
 	validate();
 }
 
-void DetectorOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void DetectorOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
 	forEachField(
 		const_cast<DetectorOptions&>(*this),
-		[&](const char* key, const auto& v) { writeKey(c, s, key, v); });
+		[&](const char* key, const auto& v) { writeKey(target, section, key, v); });
 }
 
 DetectorOptions DetectorOptions::load(const std::string& path, const std::string& section)
