@@ -99,26 +99,24 @@ struct Runner
 				m.hue_deg, m.saturation, m.intensity);
 			std::cerr << buf;
 		}
-		const auto row = [&](const char* what, double margin, const char* rule)
+		// One margin: its name, value, and the test it is the margin of
+		// (\a rule with the threshold in place of its %g).
+		const auto row = [&](const char* what, double margin, const char* rule, double threshold)
 		{
+			char test[96];
+			std::snprintf(test, sizeof test, rule, threshold);
 			std::snprintf(
-				buf, sizeof buf, "  margin %-12s %+8.3f  (%s)%s\n", what, margin, rule,
+				buf, sizeof buf, "  margin %-12s %+8.3f  (%s)%s\n", what, margin, test,
 				margin < 0 ? "  FAILS" : "");
 			std::cerr << buf;
 		};
-		char rule[96];
-		std::snprintf(rule, sizeof rule, "fill I >= %g", s.min_intensity);
-		row("intensity", c.margin_intensity, rule);
-		std::snprintf(rule, sizeof rule, "fill S >= %g", s.min_saturation);
-		row("saturation", c.margin_saturation, rule);
-		std::snprintf(rule, sizeof rule, "fill hue >= %g deg", s.hue_min_deg);
-		row("hue min", c.margin_hue_min_deg, rule);
-		std::snprintf(rule, sizeof rule, "fill hue <= %g deg", s.hue_max_deg);
-		row("hue max", c.margin_hue_max_deg, rule);
-		std::snprintf(rule, sizeof rule, "frame G / fill G <= %g", options.code.max_black_ratio);
-		row("black ratio", c.margin_black_ratio, rule);
-		std::snprintf(rule, sizeof rule, "fill G - frame G >= %g", options.code.min_contrast);
-		row("contrast", c.margin_contrast, rule);
+		row("intensity", c.margin_intensity, "fill I >= %g", s.min_intensity);
+		row("saturation", c.margin_saturation, "fill S >= %g", s.min_saturation);
+		row("hue min", c.margin_hue_min_deg, "fill hue >= %g deg", s.hue_min_deg);
+		row("hue max", c.margin_hue_max_deg, "fill hue <= %g deg", s.hue_max_deg);
+		row("black ratio", c.margin_black_ratio, "frame G / fill G <= %g",
+			options.code.max_black_ratio);
+		row("contrast", c.margin_contrast, "fill G - frame G >= %g", options.code.min_contrast);
 	}
 
 	void fail(const std::string& name, const std::string& why)

@@ -482,6 +482,7 @@ int main(int argc, char** argv)
 		const auto set = loadSet(set_dir, base);
 		pipeline::PipelineOptions popt;
 		if (configArg.isSet()) popt.detector = detect::DetectorOptions::load(configArg.getValue());
+		if (missesArg.isSet()) fs::create_directories(missesArg.getValue());
 
 		std::vector<Run> runs;
 		const auto t0 = std::chrono::steady_clock::now();
@@ -526,7 +527,6 @@ int main(int argc, char** argv)
 									if (missesArg.isSet() && run.frames[i].eligible &&
 										!run.frames[i].detected)
 									{
-										fs::create_directories(missesArg.getValue());
 										const std::string name = source + "-" + preset + "-" +
 																 f.group + "-" +
 																 std::to_string(f.index) + ".png";

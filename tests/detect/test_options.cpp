@@ -15,6 +15,26 @@
 using namespace codemark;
 using namespace codemark::detect;
 
+namespace
+{
+/** The message of the \a E that \a f throws; a test failure and "" when
+ * it throws none. */
+template <typename E, typename F>
+std::string thrownMessage(F&& f)
+{
+	try
+	{
+		f();
+	}
+	catch (const E& e)
+	{
+		return e.what();
+	}
+	ADD_FAILURE() << "expected a throw";
+	return "";
+}
+}  // namespace
+
 TEST(Options, DefaultsAreValid) { EXPECT_NO_THROW(DetectorOptions().validate()); }
 
 TEST(Options, SaveLoadRoundTrip)
@@ -43,15 +63,10 @@ TEST(Options, InvalidValuesAreRejectedByName)
 	mrpt::config::CConfigFileMemory cfg;
 	cfg.write("D", "segmentation.step_px", 9);
 	DetectorOptions o;
-	try
-	{
-		o.loadFromConfigFile(cfg, "D");
-		FAIL() << "expected a throw";
-	}
-	catch (const std::invalid_argument& e)
-	{
-		EXPECT_NE(std::string(e.what()).find("segmentation.step_px"), std::string::npos);
-	}
+	EXPECT_NE(
+		thrownMessage<std::invalid_argument>([&] { o.loadFromConfigFile(cfg, "D"); })
+			.find("segmentation.step_px"),
+		std::string::npos);
 	mrpt::config::CConfigFileMemory cfg2;
 	cfg2.write("D", "segmentation.hue_max_deg", 200);
 	EXPECT_THROW(o.loadFromConfigFile(cfg2, "D"), std::invalid_argument);
@@ -71,16 +86,9 @@ TEST(Options, ValuesOfTheWrongTypeAreRefused)
 		mrpt::config::CConfigFileMemory cfg;
 		cfg.write("D", key, text);
 		DetectorOptions o;
-		try
-		{
-			o.loadFromConfigFile(cfg, "D");
-			ADD_FAILURE() << key << " = " << text << " was accepted";
-		}
-		catch (const std::invalid_argument& e)
-		{
-			EXPECT_NE(std::string(e.what()).find(key + " = '" + text + "'"), std::string::npos)
-				<< e.what();
-		}
+		const std::string what =
+			thrownMessage<std::invalid_argument>([&] { o.loadFromConfigFile(cfg, "D"); });
+		EXPECT_NE(what.find(key + " = '" + text + "'"), std::string::npos) << what;
 	}
 	// Booleans in the spellings ini files use.
 	for (const auto& [text, value] : std::vector<std::pair<std::string, bool>>{
@@ -120,46 +128,25 @@ TEST(Options, UnknownKeysAreRefusedWithFileAndLine)
 	mrpt::config::CConfigFileMemory cfg;
 	cfg.write("D", "segmentation.min_saturaton", 0.3);
 	DetectorOptions o;
-	try
-	{
-		o.loadFromConfigFile(cfg, "D");
-		FAIL() << "an unknown key was accepted";
-	}
-	catch (const std::invalid_argument& e)
-	{
-		EXPECT_NE(std::string(e.what()).find("'segmentation.min_saturaton'"), std::string::npos)
-			<< e.what();
-	}
+	std::string what =
+		thrownMessage<std::invalid_argument>([&] { o.loadFromConfigFile(cfg, "D"); });
+	EXPECT_NE(what.find("'segmentation.min_saturaton'"), std::string::npos) << what;
 	const std::string path = testing::TempDir() + "codemark_unknown_key.ini";
 	{
 		std::ofstream f(path);
 		f << "[OTHER]\nsubpixel.no_such_option = 1\n[DETECTOR]\n# comment\n"
 			 "segmentation.step_px = 2\n  subpixel.no_such_option = true\n";
 	}
-	try
-	{
-		(void)DetectorOptions::load(path);
-		FAIL() << "an unknown key in a file was accepted";
-	}
-	catch (const std::runtime_error& e)
-	{
-		const std::string what = e.what();
-		EXPECT_NE(what.find(path + ":6:"), std::string::npos) << what;
-		EXPECT_NE(what.find("subpixel.no_such_option"), std::string::npos) << what;
-	}
+	const auto load = [&] { (void)DetectorOptions::load(path); };
+	what = thrownMessage<std::runtime_error>(load);
+	EXPECT_NE(what.find(path + ":6:"), std::string::npos) << what;
+	EXPECT_NE(what.find("subpixel.no_such_option"), std::string::npos) << what;
 	// A value of the wrong type is located on its line too.
 	{
 		std::ofstream f(path);
 		f << "[DETECTOR]\n\nsegmentation.step_px = 2x\n";
 	}
-	try
-	{
-		(void)DetectorOptions::load(path);
-		FAIL() << "a bad value was accepted";
-	}
-	catch (const std::runtime_error& e)
-	{
-		EXPECT_NE(std::string(e.what()).find(path + ":3:"), std::string::npos) << e.what();
-	}
+	what = thrownMessage<std::runtime_error>(load);
+	EXPECT_NE(what.find(path + ":3:"), std::string::npos) << what;
 	std::remove(path.c_str());
 }

@@ -3,13 +3,13 @@
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
 
-#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace codemark::detect
@@ -21,6 +21,19 @@ void require(bool ok, const char* name, const char* rule)
 	if (!ok)
 		throw std::invalid_argument(std::string("detector option ") + name + " must be " + rule);
 }
+
+/** A key refused while loading: std::invalid_argument, as
+ * loadFromConfigFile() promises, that remembers the key so that load() can
+ * name the file's line (iniWhere()). */
+class KeyError : public std::invalid_argument
+{
+   public:
+	KeyError(std::string key_, const std::string& what)
+		: std::invalid_argument(what), key(std::move(key_))
+	{
+	}
+	std::string key;
+};
 
 // Keys are "<block>.<field>", e.g. segmentation.step_px. A value that is
 // not one of its type is refused with the key and the text: MRPT's
@@ -34,7 +47,7 @@ void readKey(
 	if (first == std::string::npos) return;	 // absent: the default stays
 	text = text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
 	const auto refuse = [&](const char* what)
-	{ throw std::invalid_argument(key + " = '" + text + "' is not " + what); };
+	{ throw KeyError(key, key + " = '" + text + "' is not " + what); };
 	if constexpr (std::is_same_v<T, bool>)
 	{
 		const auto b = parseIniBoolean(text);
@@ -113,43 +126,6 @@ void forEachField(Options& o, F&& f)
 	f("code.max_frame_cell_ratio", o.code.max_frame_cell_ratio);
 	f("code.min_margin", o.code.min_margin);
 	f("code.border_px", o.code.border_px);
-}
-
-/** ":LINE" of the line in \a section of the ini file \a path that sets the
- * key a load error \a what names first ('key' quoted, or "key = ..."),
- * or "" when it cannot be found. */
-std::string lineOf(const std::string& path, const std::string& section, const std::string& what)
-{
-	std::string key;
-	const auto q = what.find('\'');
-	if (q != std::string::npos && what.compare(0, 12, "unknown key ") == 0)
-		key = what.substr(q + 1, what.find('\'', q + 1) - q - 1);
-	else
-		key = what.substr(0, what.find_first_of(" ="));
-	if (key.empty()) return "";
-	std::ifstream in(path);
-	std::string line;
-	bool inside = false;
-	for (int n = 1; std::getline(in, line); ++n)
-	{
-		const auto first = line.find_first_not_of(" \t");
-		if (first == std::string::npos) continue;
-		if (line[first] == '[')
-		{
-			const auto end = line.find(']', first);
-			std::string name = line.substr(first + 1, end - first - 1);
-			inside = name.size() == section.size() &&
-					 std::equal(
-						 name.begin(), name.end(), section.begin(),
-						 [](char a, char b) { return std::tolower(a) == std::tolower(b); });
-			continue;
-		}
-		if (inside && line.compare(first, key.size(), key) == 0 &&
-			line.find_first_not_of(" \t", first + key.size()) != std::string::npos &&
-			line[line.find_first_not_of(" \t", first + key.size())] == '=')
-			return ":" + std::to_string(n);
-	}
-	return "";
 }
 }  // namespace
 
@@ -234,9 +210,9 @@ void DetectorOptions::loadFromConfigFile(
 		bool known = false;
 		forEachField(*this, [&](const char* key, const auto&) { known = known || k == key; });
 		if (!known)
-			throw std::invalid_argument(
-				"unknown key '" + k +
-				"' (not a detector option; share/codemark/detector.ini lists them all)");
+			throw KeyError(
+				k, "unknown key '" + k +
+					   "' (not a detector option; share/codemark/detector.ini lists them all)");
 	}
 	forEachField(*this, [&](const char* key, auto& v) { readKey(source, section, key, v); });
 	validate();
@@ -262,10 +238,13 @@ DetectorOptions DetectorOptions::load(const std::string& path, const std::string
 	{
 		o.loadFromConfigFile(cfg, section);
 	}
+	catch (const KeyError& e)
+	{
+		throw std::runtime_error(iniWhere(path, section, e.key) + "[" + section + "]: " + e.what());
+	}
 	catch (const std::exception& e)
 	{
-		throw std::runtime_error(
-			path + lineOf(path, section, e.what()) + ": [" + section + "]: " + e.what());
+		throw std::runtime_error(path + ": [" + section + "]: " + e.what());
 	}
 	return o;
 }
