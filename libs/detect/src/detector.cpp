@@ -88,6 +88,11 @@ DetectionResult detect(
 			refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio);
 		tm.subpixel_us += microsSince(t);
 		if (!refined) continue;
+		if (opt.subpixel.frame_midline)
+			centreOnFrame(
+				bgr, *refined, camera, thr, frame_ratio, geometry.margin_m / geometry.inner_size_m,
+				opt.subpixel);
+		tm.subpixel_us += microsSince(t);
 		++res.counts.fitted;
 
 		// 8. Code cells through the corners' homography.

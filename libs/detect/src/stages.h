@@ -180,7 +180,9 @@ int steepestRise(const int* v, int lo, int hi);
  * (indices), the edge rising in the direction of increasing index. Nullopt
  * when the peak derivative is below \a min_rise (grey levels per px). In
  * Peak mode with \a neighbour_px > 0, the lobe of a falling edge that far
- * before this one (a thin frame's outer edge) is modelled and removed. */
+ * before this one (a thin frame's outer edge) is modelled and removed; with
+ * \a neighbour_px < 0, that of one -neighbour_px after it (the quiet
+ * margin's edge, read from the frame outwards). */
 std::optional<double> locateRisingEdge(
 	const int* values, int n, int lo, int hi, double min_rise, const SubpixelParams& p,
 	EdgeMode mode = EdgeMode::Centroid, double neighbour_px = 0);
@@ -408,6 +410,31 @@ struct RefinedQuad
 std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& camera, double min_rise,
 	double frame_ratio, const SubpixelParams& p, double fill_ratio = 35.0 / 160);
+
+/** Corners from the four sides' lines (ideal px), distorted back to raw
+ * pixels; false where neighbouring sides are parallel. */
+bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
+
+/** One side of \a q re-fitted on the black frame's midline: per profile,
+ * the inner and the outer edge of the frame (the same locator, mirrored),
+ * their midpoint moved inwards by half the frame's width predicted from the
+ * square's homography. Returns the median shift of the edges [px, positive
+ * inwards]; nullopt (\a q unchanged) where the quiet margin is under a
+ * pixel (\a margin_ratio: its width over the inner side) or too few
+ * profiles read both edges. */
+std::optional<double> frameMidlineSide(
+	const cv::Mat& bgr, RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
+	double frame_ratio, double margin_ratio, const SubpixelParams& p);
+
+/** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
+ * on every side it reads (the frame reads narrower than the homography's
+ * width all round: a transfer curve or a clip bent its edges), each side
+ * goes to the frame's midline, twice (the second pass with the frame's
+ * width from the first's square), and the corners follow; otherwise \a q
+ * stays as it is. */
+void centreOnFrame(
+	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
+	double frame_ratio, double margin_ratio, const SubpixelParams& p);
 
 // ------------------------------------------------------------------ stage 8
 /** The code of one landmark. */

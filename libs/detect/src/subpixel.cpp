@@ -160,11 +160,16 @@ std::optional<double> locateRisingEdge(
 		// width instead; its iterations re-estimate the width from the
 		// corrected samples (the result moves by < 0.005 px for seeds of 0.5
 		// to 0.9 px^2).
-		if (neighbour_px > 0 && var <= 0) var = kLobeSeedVarPx2;
-		if (neighbour_px > 0 && var > 0 && ko >= 1 && ko <= n - 2 && ko < peak)
+		// A negative neighbour_px puts that edge after this one (the quiet
+		// margin's outer edge, read from the frame outwards).
+		const bool before = neighbour_px > 0;
+		if (neighbour_px != 0 && var <= 0) var = kLobeSeedVarPx2;
+		if (neighbour_px != 0 && var > 0 && ko >= 1 && ko <= n - 2 &&
+			(before ? ko < peak : ko > peak))
 		{
 			int lowest = d(ko);
-			for (int k = std::max(1, ko - 1); k <= std::min(ko + 1, peak - 1); ++k)
+			for (int k = before ? std::max(1, ko - 1) : std::max(peak + 1, ko - 1);
+				 k <= (before ? std::min(ko + 1, peak - 1) : std::min(ko + 1, n - 2)); ++k)
 				lowest = std::min(lowest, d(k));
 			if (lowest < 0)
 			{

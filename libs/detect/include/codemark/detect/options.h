@@ -192,6 +192,15 @@ struct SubpixelParams
 	 * then no worse than AprilTag 3 in any cell; the shipped C_P is
 	 * calibrated with it (pipeline.h, docs/benchmarks/pose.md). */
 	bool thin_frame_model = true;
+	/** Where the black frame reads narrower than the square's homography
+	 * says on every side (by 0.2 px or more: a camera's transfer curve, or
+	 * a clip, bends both of its edges towards the black), place each side
+	 * on the frame's midline, read between its inner and outer edges, less
+	 * half the frame's width: the bend, a clip and printers' dot gain
+	 * cancel there.
+	 * Sides whose quiet margin is narrower than a pixel, or than the
+	 * edge's blur at half maximum, keep their single-edge line. */
+	bool frame_midline = true;
 	/** Refine the derivative's peak with the exact response of a
 	 * pixel-integrated Gaussian step (its position, blur and height from
 	 * the three samples) instead of the log-parabola's Gaussian, which
