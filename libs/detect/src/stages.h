@@ -415,16 +415,24 @@ std::optional<RefinedQuad> refineQuadrangle(
  * pixels; false where neighbouring sides are parallel. */
 bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
 
+/** A side's line on the frame's midline and the median shift of its edges
+ * [px, positive inwards]. */
+struct FrameMidline
+{
+	LineFit line;
+	double shift_px = 0;
+};
+
 /** One side of \a q re-fitted on the black frame's midline: per profile,
  * the inner and the outer edge of the frame (the same locator, mirrored),
- * their midpoint moved inwards by half the frame's width predicted from the
- * square's homography. Returns the median shift of the edges [px, positive
- * inwards]; nullopt (\a q unchanged) where the quiet margin is under a
- * pixel (\a margin_ratio: its width over the inner side) or too few
- * profiles read both edges. */
-std::optional<double> frameMidlineSide(
-	const cv::Mat& bgr, RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
-	double frame_ratio, double margin_ratio, const SubpixelParams& p);
+ * the missing width shared between them in the ratio of their bends, the
+ * inner edge moved inwards by its share. Nullopt where the quiet margin is
+ * unresolved (\a margin_ratio: its width over the inner side) or too few
+ * profiles read both edges. Reads at most about \a max_profiles profiles,
+ * evenly spread along the side. */
+std::optional<FrameMidline> frameMidlineSide(
+	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
+	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles);
 
 /** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
  * on every side it reads (the frame reads narrower than the homography's
