@@ -36,8 +36,8 @@ const double kMarginBlurs = std::sqrt(2 * std::log(2.0));
 constexpr double kMinShiftPx = 0.1;
 /** Profiles read a side at most: for the decision and the first square
  * (the second pass's frame widths), and for the final line. The midline's
- * scatter per profile is a few hundredths of a pixel: 64 profiles fix a
- * line to well under one. */
+ * scatter per profile is under a tenth of a pixel on a noisy frame: 64
+ * profiles fix a line to about a hundredth. */
 constexpr int kDecisionProfiles = 24, kLineProfiles = 64;
 
 /** Across coordinate [raw px] of a polyline (points ordered along) at
