@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -56,6 +57,20 @@ DetectorOptions singleEdgeModels()
 	DetectorOptions o;
 	o.subpixel.frame_midline = false;
 	return o;
+}
+
+/** Each edge's outward shift [px] of the one landmark found in \a image:
+ * a quarter of the growth of its P's width (x2 - x1) and half-heights (y1,
+ * y2) against \a truth_P. NaN, and a failure, unless exactly one is found. */
+double edgeGrowth(
+	const cv::Mat& image, const CameraModel& camera, const DetectorOptions& opt,
+	const Eigen::Vector4d& truth_P)
+{
+	const auto r = detect::detect(image, camera, LandmarkGeometry(), opt);
+	EXPECT_EQ(r.landmarks.size(), 1u);
+	if (r.landmarks.size() != 1) return std::nan("");
+	const Eigen::Vector4d e = r.landmarks[0].P - truth_P;
+	return 0.25 * (e[2] - e[0] + e[1] + e[3]);
 }
 }  // namespace
 
@@ -218,12 +233,7 @@ TEST(Renders, ClippedFillDoesNotInflateTheSquare)
 					{
 						DetectorOptions opt = singleEdgeModels();
 						opt.subpixel.model_clipping = clipping;
-						const auto r =
-							detect::detect(s.render.image, CameraModel(), LandmarkGeometry(), opt);
-						ASSERT_EQ(r.landmarks.size(), 1u);
-						const Eigen::Vector4d e = r.landmarks[0].P - t.P;
-						// Half the growth of width and height: each edge's outward shift.
-						grow[clipping] += 0.25 * (e[2] - e[0] + e[1] + e[3]);
+						grow[clipping] += edgeGrowth(s.render.image, CameraModel(), opt, t.P);
 					}
 				}
 			const double without = grow[0] / n, with = grow[1] / n;
@@ -575,11 +585,7 @@ TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
 					{
 						DetectorOptions opt;
 						opt.subpixel.frame_midline = midline;
-						const auto r =
-							detect::detect(s.render.image, CameraModel(), LandmarkGeometry(), opt);
-						ASSERT_EQ(r.landmarks.size(), 1u);
-						const Eigen::Vector4d e = r.landmarks[0].P - t.P;
-						grow[midline] += 0.25 * (e[2] - e[0] + e[1] + e[3]);
+						grow[midline] += edgeGrowth(s.render.image, CameraModel(), opt, t.P);
 					}
 				}
 			const double without = grow[0] / n, with = grow[1] / n;
@@ -644,12 +650,10 @@ TEST(Renders, FrameMidlineOnCommittedPovrayFrames)
 			const cv::Mat image = sim::cameraImage(copy, o, camera.cx(), camera.cy(), 17 + n);
 			for (const bool midline : {false, true})
 			{
+				SCOPED_TRACE(g);
 				DetectorOptions opt;
 				opt.subpixel.frame_midline = midline;
-				const auto r = detect::detect(image, camera, LandmarkGeometry(), opt);
-				ASSERT_EQ(r.landmarks.size(), 1u) << g;
-				const Eigen::Vector4d e = r.landmarks[0].P - P;
-				grow[midline] += 0.25 * (e[2] - e[0] + e[1] + e[3]);
+				grow[midline] += edgeGrowth(image, camera, opt, P);
 			}
 			++n;
 		}

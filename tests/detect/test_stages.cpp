@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <optional>
 #include <random>
+#include <utility>
 
 using namespace codemark;
 using namespace codemark::detect;
@@ -690,10 +692,10 @@ TEST(Subpixel, FillLevelFromChannelsTellsATopFillFromAClippedOne)
 
 namespace
 {
-/** A thin black frame: wall level \a wall up to x0 - width, black (20)
- * up to x0, green fill (250) beyond, blurred by a Gaussian of \a sigma and
- * integrated over each pixel (numerically). */
-std::vector<int> thinFrameProfile(double x0, double width, double sigma, double wall, int n)
+/** Steps of \a heights at \a positions on a level \a base, blurred by a
+ * Gaussian of \a sigma and integrated over each pixel (numerically). */
+std::vector<int> blurredSteps(
+	double base, std::initializer_list<std::pair<double, double>> steps, double sigma, int n)
 {
 	std::vector<int> v(n);
 	const auto Phi = [&](double x) { return 0.5 * (1 + std::erf(x / (std::sqrt(2.0) * sigma))); };
@@ -704,11 +706,20 @@ std::vector<int> thinFrameProfile(double x0, double width, double sigma, double 
 		for (int k = 0; k < kSub; ++k)
 		{
 			const double x = i - 0.5 + (k + 0.5) / kSub;
-			s += wall + (20 - wall) * Phi(x - (x0 - width)) + (250 - 20) * Phi(x - x0);
+			double y = base;
+			for (const auto& [at, height] : steps) y += height * Phi(x - at);
+			s += y;
 		}
 		v[i] = static_cast<int>(std::lround(s / kSub));
 	}
 	return v;
+}
+
+/** A thin black frame: wall level \a wall up to x0 - width, black (20)
+ * up to x0, green fill (250) beyond. */
+std::vector<int> thinFrameProfile(double x0, double width, double sigma, double wall, int n)
+{
+	return blurredSteps(wall, {{x0 - width, 20 - wall}, {x0, 250 - 20}}, sigma, n);
 }
 }  // namespace
 
@@ -752,24 +763,10 @@ TEST(Subpixel, PeakModeRemovesMostOfTheOuterEdgeOfAThinFrame)
 namespace
 {
 /** The frame's outer edge read outwards: black (20) up to x0, the sheet's
- * white (235) for \a margin px, then the wall's level \a wall, blurred by
- * a Gaussian of \a sigma and integrated over each pixel (numerically). */
+ * white (235) for \a margin px, then the wall's level \a wall. */
 std::vector<int> marginProfile(double x0, double margin, double sigma, double wall, int n)
 {
-	std::vector<int> v(n);
-	const auto Phi = [&](double x) { return 0.5 * (1 + std::erf(x / (std::sqrt(2.0) * sigma))); };
-	for (int i = 0; i < n; ++i)
-	{
-		double s = 0;
-		constexpr int kSub = 64;
-		for (int k = 0; k < kSub; ++k)
-		{
-			const double x = i - 0.5 + (k + 0.5) / kSub;
-			s += 20 + (235 - 20) * Phi(x - x0) + (wall - 235) * Phi(x - (x0 + margin));
-		}
-		v[i] = static_cast<int>(std::lround(s / kSub));
-	}
-	return v;
+	return blurredSteps(20, {{x0, 235 - 20}, {x0 + margin, wall - 235}}, sigma, n);
 }
 }  // namespace
 

@@ -81,30 +81,6 @@ std::vector<Eigen::Vector2d> sidePolyline(
 }
 }  // namespace
 
-bool cornersFromSides(RefinedQuad& q, const CameraModel& cam)
-{
-	// Corner k = side k-1 x side k (TL = left x top, ...).
-	for (int k = 0; k < 4; ++k)
-	{
-		const LineFit& l1 = q.sides[(k + 3) % 4];
-		const LineFit& l2 = q.sides[k];
-		const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
-									  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
-		if (std::abs(h.z()) < 1e-9) return false;
-		q.corners_ideal[k] = h.head<2>() / h.z();
-		if (cam.hasDistortion())
-		{
-			const Eigen::Vector2d xn(
-				(q.corners_ideal[k].x() - cam.cx()) / cam.fx(),
-				(q.corners_ideal[k].y() - cam.cy()) / cam.fy());
-			q.corners_raw[k] = cam.distortNormalized(xn);
-		}
-		else
-			q.corners_raw[k] = q.corners_ideal[k];
-	}
-	return true;
-}
-
 std::optional<FrameMidline> frameMidlineSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& cam, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles)

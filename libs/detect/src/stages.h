@@ -411,6 +411,10 @@ std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& camera, double min_rise,
 	double frame_ratio, const SubpixelParams& p, double fill_ratio = 35.0 / 160);
 
+/** Corner k (TL, TR, BR, BL) of four sides' lines (top, right, bottom,
+ * left): side k-1 x side k; nullopt where they are parallel. */
+std::optional<Eigen::Vector2d> cornerOfSides(const std::array<LineFit, 4>& sides, int k);
+
 /** Corners from the four sides' lines (ideal px), distorted back to raw
  * pixels; false where neighbouring sides are parallel. */
 bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);

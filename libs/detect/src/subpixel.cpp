@@ -830,16 +830,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 	for (int side = 0; side < 4; ++side)
 		if (undecided[side] && (some_at_top || channels_agree[side]) && !refineSide(side, true))
 			return std::nullopt;
-	// Corner k = side k-1 x side k (TL = left x top, ...).
-	const auto intersect = [&](int k) -> std::optional<Eigen::Vector2d>
-	{
-		const LineFit& l1 = out.sides[(k + 3) % 4];
-		const LineFit& l2 = out.sides[k];
-		const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
-									  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
-		if (std::abs(h.z()) < 1e-9) return std::nullopt;
-		return Eigen::Vector2d(h.head<2>() / h.z());
-	};
 	if (std::any_of(thin.begin(), thin.end(), [](const auto& t) { return t.has_value(); }))
 	{
 		// The thin sides' model of the print (thinFrameOffset()): the
@@ -851,7 +841,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		bool ok = true;
 		for (int k = 0; k < 4 && ok; ++k)
 		{
-			const auto c = intersect(k);
+			const auto c = cornerOfSides(out.sides, k);
 			ok = c.has_value();
 			if (ok) refined[k] = *c;
 		}
@@ -906,24 +896,42 @@ std::optional<RefinedQuad> refineQuadrangle(
 				}
 		}
 	}
+	if (!cornersFromSides(out, cam)) return std::nullopt;
+	// The refinement must stay near the coarse corner.
+	for (int k = 0; k < 4; ++k)
+		if ((out.corners_raw[k] - coarse[k]).norm() > 3.0 + p.search_px) return std::nullopt;
+	return out;
+}
+
+std::optional<Eigen::Vector2d> cornerOfSides(const std::array<LineFit, 4>& sides, int k)
+{
+	// Corner k = side k-1 x side k (TL = left x top, ...).
+	const LineFit& l1 = sides[(k + 3) % 4];
+	const LineFit& l2 = sides[k];
+	const Eigen::Vector3d h = Eigen::Vector3d(l1.normal.x(), l1.normal.y(), l1.c)
+								  .cross(Eigen::Vector3d(l2.normal.x(), l2.normal.y(), l2.c));
+	if (std::abs(h.z()) < 1e-9) return std::nullopt;
+	return Eigen::Vector2d(h.head<2>() / h.z());
+}
+
+bool cornersFromSides(RefinedQuad& q, const CameraModel& cam)
+{
 	for (int k = 0; k < 4; ++k)
 	{
-		const auto corner = intersect(k);
-		if (!corner) return std::nullopt;
-		out.corners_ideal[k] = *corner;
-		if (distorted)
+		const auto corner = cornerOfSides(q.sides, k);
+		if (!corner) return false;
+		q.corners_ideal[k] = *corner;
+		if (cam.hasDistortion())
 		{
 			const Eigen::Vector2d xn(
-				(out.corners_ideal[k].x() - cam.cx()) / cam.fx(),
-				(out.corners_ideal[k].y() - cam.cy()) / cam.fy());
-			out.corners_raw[k] = cam.distortNormalized(xn);
+				(q.corners_ideal[k].x() - cam.cx()) / cam.fx(),
+				(q.corners_ideal[k].y() - cam.cy()) / cam.fy());
+			q.corners_raw[k] = cam.distortNormalized(xn);
 		}
 		else
-			out.corners_raw[k] = out.corners_ideal[k];
-		// The refinement must stay near the coarse corner.
-		if ((out.corners_raw[k] - coarse[k]).norm() > 3.0 + p.search_px) return std::nullopt;
+			q.corners_raw[k] = q.corners_ideal[k];
 	}
-	return out;
+	return true;
 }
 
 }  // namespace codemark::detect
