@@ -78,7 +78,7 @@ TEST(Options, InvalidValuesAreRejectedByName)
 TEST(Options, ValuesOfTheWrongTypeAreRefused)
 {
 	for (const auto& [key, text] : std::vector<std::pair<std::string, std::string>>{
-			 {"subpixel.thin_frame_model", "maybe"},
+			 {"segmentation.box_smoothing", "maybe"},
 			 {"segmentation.step_px", "3x"},
 			 {"segmentation.step_px", "2.5"},
 			 {"subpixel.outlier_sigmas", "2.5 px"}})
@@ -95,11 +95,11 @@ TEST(Options, ValuesOfTheWrongTypeAreRefused)
 			 {"true", true}, {"False", false}, {"1", true}, {"0", false}, {"yes", true}})
 	{
 		mrpt::config::CConfigFileMemory cfg;
-		cfg.write("D", "subpixel.thin_frame_model", text);
+		cfg.write("D", "segmentation.box_smoothing", text);
 		DetectorOptions o;
-		o.subpixel.thin_frame_model = !value;
+		o.segmentation.box_smoothing = !value;
 		o.loadFromConfigFile(cfg, "D");
-		EXPECT_EQ(o.subpixel.thin_frame_model, value) << text;
+		EXPECT_EQ(o.segmentation.box_smoothing, value) << text;
 	}
 }
 
@@ -131,6 +131,19 @@ TEST(Options, UnknownKeysAreRefusedWithFileAndLine)
 	std::string what =
 		thrownMessage<std::invalid_argument>([&] { o.loadFromConfigFile(cfg, "D"); });
 	EXPECT_NE(what.find("'segmentation.min_saturaton'"), std::string::npos) << what;
+	// The sub-pixel stage's model switches are for tests and benchmarks
+	// (SubpixelModels), not detector options: a file that sets one is told
+	// so rather than left believing a model is off.
+	for (const char* key :
+		 {"subpixel.thin_frame_model", "subpixel.frame_midline", "subpixel.model_clipping",
+		  "subpixel.step_model_peak", "subpixel.model_outer_edge",
+		  "subpixel.correct_level_rounding"})
+	{
+		mrpt::config::CConfigFileMemory models;
+		models.write("D", key, "false");
+		what = thrownMessage<std::invalid_argument>([&] { o.loadFromConfigFile(models, "D"); });
+		EXPECT_NE(what.find(std::string("'") + key + "'"), std::string::npos) << what;
+	}
 	const std::string path = testing::TempDir() + "codemark_unknown_key.ini";
 	{
 		std::ofstream f(path);

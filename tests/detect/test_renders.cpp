@@ -2,6 +2,7 @@
 // landmark found with the right ID and corners within 0.3 px over the
 // ranges of issue 3, exhaustive decoding, flipped cells, negatives.
 #include "common.h"
+#include "stages.h"
 
 #include <codemark/landmark/codebook.h>
 #include <codemark/sim/camera_pipeline.h>
@@ -47,26 +48,27 @@ std::string label(const char* name, double v, uint64_t seed)
 	s << name << "=" << v << " seed=" << seed;
 	return s.str();
 }
-/** The detector's options with the frame's midline off: the clip's tests
+/** The sub-pixel stage's models with the frame's midline off: the clip's tests
  * below are of the single-edge models, in linear light, where they are
  * exact. A fill and a sheet clipped by different amounts narrow the frame
  * too, and the midline (which assumes both edges bend alike) would take
  * those sides over. */
-DetectorOptions singleEdgeModels()
+SubpixelModels singleEdgeModels()
 {
-	DetectorOptions o;
-	o.subpixel.frame_midline = false;
-	return o;
+	SubpixelModels m;
+	m.frame_midline = false;
+	return m;
 }
 
 /** Each edge's outward shift [px] of the one landmark found in \a image:
  * a quarter of the growth of its P's width (x2 - x1) and half-heights (y1,
  * y2) against \a truth_P. NaN, and a failure, unless exactly one is found. */
 double edgeGrowth(
-	const cv::Mat& image, const CameraModel& camera, const DetectorOptions& opt,
+	const cv::Mat& image, const CameraModel& camera, const SubpixelModels& models,
 	const Eigen::Vector4d& truth_P)
 {
-	const auto r = detect::detect(image, camera, LandmarkGeometry(), opt);
+	const auto r =
+		detect::detectWithModels(image, camera, LandmarkGeometry(), DetectorOptions(), models);
 	EXPECT_EQ(r.landmarks.size(), 1u);
 	if (r.landmarks.size() != 1) return std::nan("");
 	const Eigen::Vector4d e = r.landmarks[0].P - truth_P;
@@ -185,8 +187,9 @@ TEST(Renders, NoiseFreeFillAtOrAboveTheTopSeenSquarely)
 				o.gain = gain;
 				const Shot s = shoot(37, dist, 0, o, 1, bearing, 0.05);
 				const auto& t = s.render.truth[0];
-				const auto r = detect::detect(
-					s.render.image, CameraModel(), LandmarkGeometry(), singleEdgeModels());
+				const auto r = detect::detectWithModels(
+					s.render.image, CameraModel(), LandmarkGeometry(), DetectorOptions(),
+					singleEdgeModels());
 				ASSERT_EQ(r.landmarks.size(), 1u) << gain << " " << dist << " " << bearing;
 				for (int k = 0; k < 4; ++k)
 				{
@@ -211,7 +214,7 @@ TEST(Renders, NoiseFreeFillAtOrAboveTheTopSeenSquarely)
 // A fill brighter than the sensor's top clips G on the bright half of the
 // inner edge's response: read as it is, the edge moves outwards and the
 // square looks larger (a range error). The edge model fitted with the clip
-// (SubpixelParams::model_clipping) must remove most of it, at gains from a
+// (SubpixelModels::clipping) must remove most of it, at gains from a
 // fill exactly at the top (only the noise clips) to 1.6, near and far.
 TEST(Renders, ClippedFillDoesNotInflateTheSquare)
 {
@@ -231,9 +234,9 @@ TEST(Renders, ClippedFillDoesNotInflateTheSquare)
 					ASSERT_TRUE(t.fully_visible);
 					for (const bool clipping : {false, true})
 					{
-						DetectorOptions opt = singleEdgeModels();
-						opt.subpixel.model_clipping = clipping;
-						grow[clipping] += edgeGrowth(s.render.image, CameraModel(), opt, t.P);
+						SubpixelModels models = singleEdgeModels();
+						models.clipping = clipping;
+						grow[clipping] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
 					}
 				}
 			const double without = grow[0] / n, with = grow[1] / n;
@@ -559,7 +562,7 @@ TEST(Renders, GreyOnlyImageGivesNothing)
 // black frame towards the black: read alone, the inner edge moves outwards
 // and the square looks larger, by a few tenths of a pixel through sRGB,
 // gamma and a phone's filmic curve, with sharpening and JPEG after them.
-// The frame's midline (SubpixelParams::frame_midline) cancels the bend:
+// The frame's midline (SubpixelModels::frame_midline) cancels the bend:
 // each edge's mean outward shift, with and without it, near and far,
 // squarely and at 30 deg.
 TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
@@ -583,9 +586,9 @@ TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
 					ASSERT_TRUE(t.fully_visible);
 					for (const bool midline : {false, true})
 					{
-						DetectorOptions opt;
-						opt.subpixel.frame_midline = midline;
-						grow[midline] += edgeGrowth(s.render.image, CameraModel(), opt, t.P);
+						SubpixelModels models;
+						models.frame_midline = midline;
+						grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
 					}
 				}
 			const double without = grow[0] / n, with = grow[1] / n;
@@ -651,9 +654,9 @@ TEST(Renders, FrameMidlineOnCommittedPovrayFrames)
 			for (const bool midline : {false, true})
 			{
 				SCOPED_TRACE(g);
-				DetectorOptions opt;
-				opt.subpixel.frame_midline = midline;
-				grow[midline] += edgeGrowth(image, camera, opt, P);
+				SubpixelModels models;
+				models.frame_midline = midline;
+				grow[midline] += edgeGrowth(image, camera, models, P);
 			}
 			++n;
 		}

@@ -431,16 +431,15 @@ TEST(Subpixel, PeakModeLocatesAGaussianBlurredStep)
 // and on blurred ones alike, down to the profile's 8-bit rounding.
 TEST(Subpixel, PeakModeStepModelLocatesSharpAndBlurredSteps)
 {
-	SubpixelParams model, gauss;
-	gauss.step_model_peak = false;
+	const SubpixelParams p;
 	for (double sigma : {0.0, 0.3, 0.5, 0.8, 1.2})
 	{
 		double worst_model = 0, worst_gauss = 0;
 		for (double x0 = 9.0; x0 < 10.0; x0 += 0.05)
 		{
 			const auto v = stepProfile(x0, sigma, 21);
-			const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, model, EdgeMode::Peak);
-			const auto g = locateRisingEdge(v.data(), 21, 7, 13, 5, gauss, EdgeMode::Peak);
+			const auto e = locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::Peak);
+			const auto g = locateRisingEdge(v.data(), 21, 7, 13, 5, p, EdgeMode::PeakGaussian);
 			ASSERT_TRUE(e && g);
 			worst_model = std::max(worst_model, std::abs(*e - x0));
 			worst_gauss = std::max(worst_gauss, std::abs(*g - x0));
@@ -852,9 +851,10 @@ TEST(Subpixel, RefinedCornersOfACraftedLandmark)
 			const cv::Mat img = craftedLandmark(0x5A, 40, blur);
 			const auto q = coarseQuad(img);
 			ASSERT_TRUE(q);
-			SubpixelParams p;
-			p.model_clipping = clipping;
-			const auto r = refineQuadrangle(img, *q, CameraModel(), 10, 0.125, p);
+			SubpixelModels models;
+			models.clipping = clipping;
+			const auto r = refineQuadrangle(
+				img, *q, CameraModel(), 10, 0.125, SubpixelParams(), 35.0 / 160, models);
 			ASSERT_TRUE(r);
 			const auto truth = craftedCorners();
 			for (int k = 0; k < 4; ++k)

@@ -146,7 +146,7 @@ TEST(PoseNees, ClosedFormIsConsistentOnRenders) { checkNees(0); }
 // and fill (22.5 and 229.5) both round by half a level, the same in every
 // profile: that tilts a side whose edge crosses a pixel boundary (phi2 off
 // by 1.2e-3 rad at 2 m seen squarely, without
-// SubpixelParams::correct_level_rounding). The exact-corner round trip to
+// detect::correctLevelRounding()). The exact-corner round trip to
 // 1e-6 is tests/pose/test_sim.cpp.
 TEST(PoseOnRenders, NoiseFreeRendersRecoverLAndPose)
 {

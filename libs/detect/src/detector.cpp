@@ -35,6 +35,13 @@ DetectionResult detect(
 	const cv::Mat& bgr, const CameraModel& camera, const LandmarkGeometry& geometry,
 	const DetectorOptions& opt, const std::string& debug_dir)
 {
+	return detectWithModels(bgr, camera, geometry, opt, SubpixelModels(), debug_dir);
+}
+
+DetectionResult detectWithModels(
+	const cv::Mat& bgr, const CameraModel& camera, const LandmarkGeometry& geometry,
+	const DetectorOptions& opt, const SubpixelModels& models, const std::string& debug_dir)
+{
 	DetectionResult res;
 	if (bgr.empty()) return res;
 	if (bgr.type() != CV_8UC3)
@@ -84,11 +91,11 @@ DetectionResult detect(
 		++res.counts.quads;
 
 		// 7. Sub-pixel edges, a line per side, corners.
-		auto refined =
-			refineQuadrangle(bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio);
+		auto refined = refineQuadrangle(
+			bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio, models);
 		tm.subpixel_us += microsSince(t);
 		if (!refined) continue;
-		if (opt.subpixel.frame_midline)
+		if (models.frame_midline)
 			centreOnFrame(
 				bgr, *refined, camera, thr, frame_ratio, geometry.margin_m / geometry.inner_size_m,
 				opt.subpixel);

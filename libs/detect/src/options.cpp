@@ -108,12 +108,6 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.reach_px", o.subpixel.reach_px);
 	f("subpixel.saturation_level", o.subpixel.saturation_level);
 	f("subpixel.min_frame_px_centroid", o.subpixel.min_frame_px_centroid);
-	f("subpixel.model_outer_edge", o.subpixel.model_outer_edge);
-	f("subpixel.thin_frame_model", o.subpixel.thin_frame_model);
-	f("subpixel.frame_midline", o.subpixel.frame_midline);
-	f("subpixel.step_model_peak", o.subpixel.step_model_peak);
-	f("subpixel.correct_level_rounding", o.subpixel.correct_level_rounding);
-	f("subpixel.model_clipping", o.subpixel.model_clipping);
 	f("subpixel.clipped_fraction", o.subpixel.clipped_fraction);
 	f("subpixel.min_rise_rb", o.subpixel.min_rise_rb);
 	f("subpixel.outlier_sigmas", o.subpixel.outlier_sigmas);

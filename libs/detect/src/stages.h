@@ -4,6 +4,7 @@
  * recognition"), declared here so that tests can run a single stage on a
  * crafted input. detect() in detector.cpp calls them in this order.
  */
+#include <codemark/detect/detector.h>
 #include <codemark/detect/options.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/landmark/codebook.h>
@@ -145,12 +146,39 @@ using Quad = std::array<Eigen::Vector2d, 4>;
 std::optional<Quad> linkQuadrangle(const SideSegments& s, const QuadParams& p);
 
 // ------------------------------------------------------------------ stage 7
+/** Switches for the sub-pixel stage's models, for the tests and benchmarks
+ * that measure what each one does. Not detector options: the detector runs
+ * them all. */
+struct SubpixelModels
+{
+	/** Restore clipped G samples before the edges are read (imputeFillLevel(),
+	 * imputeClippedSide()). */
+	bool clipping = true;
+	/** Remove the frame's outer edge's lobe in the Peak locator. */
+	bool outer_edge = true;
+	/** Shift thin sides by their print model's offset (thinFrameOffset()). */
+	bool thin_frame = true;
+	/** Stage 7b: centreOnFrame(). */
+	bool frame_midline = true;
+	/** The Peak locator's step model (EdgeMode::Peak rather than
+	 * EdgeMode::PeakGaussian). */
+	bool step_peak = true;
+	/** correctLevelRounding() on noise-free sharp sides. */
+	bool level_rounding = true;
+};
+
 /** How locateRisingEdge() places the edge. */
 enum class EdgeMode
 {
 	Centroid,  //!< centroid of the derivative response around its peak
 	IsolatedCentroid,  //!< the same, stopping where the response rises again (a neighbouring edge)
-	Peak  //!< the derivative's peak: a Gaussian through three samples
+	/** The derivative's peak: the pixel-integrated Gaussian step whose
+	 * response fits the three samples around it exactly. */
+	Peak,
+	/** The same peak from a Gaussian through the three samples (a
+	 * log-parabola): errs with the edge's phase in its pixel on sharp
+	 * edges, but needs no blur to centre a search. */
+	PeakGaussian
 };
 
 /** A Gaussian-blurred unit step (blur \a sigma [px]) at 0, averaged over
@@ -409,7 +437,8 @@ struct RefinedQuad
  * (35 / 160). */
 std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& camera, double min_rise,
-	double frame_ratio, const SubpixelParams& p, double fill_ratio = 35.0 / 160);
+	double frame_ratio, const SubpixelParams& p, double fill_ratio = 35.0 / 160,
+	const SubpixelModels& models = {});
 
 /** Corner k (TL, TR, BR, BL) of four sides' lines (top, right, bottom,
  * left): side k-1 x side k; nullopt where they are parallel. */
@@ -497,5 +526,13 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v);
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
 	const CodeParams& p);
+
+// ---------------------------------------------------------------- detector
+/** detect() with the sub-pixel stage's models switched by \a models (the
+ * tests and benchmarks that measure a model's effect). */
+DetectionResult detectWithModels(
+	const cv::Mat& bgr, const CameraModel& camera, const LandmarkGeometry& geometry,
+	const DetectorOptions& options, const SubpixelModels& models,
+	const std::string& debug_dir = {});
 
 }  // namespace codemark::detect

@@ -1,4 +1,5 @@
 // Stage 7: sub-pixel edge points, line fits, corners.
+#include "edge_models.h"
 #include "stages.h"
 
 #include <Eigen/Dense>
@@ -135,7 +136,7 @@ std::optional<double> locateRisingEdge(
 	const int peak = steepestRise(v, lo, hi);
 	const int dp = d(peak);
 	if (dp < 2 * min_rise) return std::nullopt;
-	const bool at_peak = mode == EdgeMode::Peak;
+	const bool at_peak = mode == EdgeMode::Peak || mode == EdgeMode::PeakGaussian;
 	const bool monotone = mode == EdgeMode::IsolatedCentroid;
 	if (at_peak)
 	{
@@ -195,7 +196,8 @@ std::optional<double> locateRisingEdge(
 				}
 			}
 		}
-		return km < peak && kp > peak && p.step_model_peak ? stepPeak(fitted, peak, e, var) : e;
+		return km < peak && kp > peak && mode == EdgeMode::Peak ? stepPeak(fitted, peak, e, var)
+																: e;
 	}
 	// The response of a blurred step: sum the derivative while it stays
 	// positive and above a fraction of the peak; its centroid is the edge
@@ -527,15 +529,84 @@ std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelP
 	return f;
 }
 
+namespace
+{
+/** A thin side (read by the Peak locator in G) kept for
+ * applyThinFrameModel(): its profiles and edges. */
+struct ThinSide
+{
+	std::vector<int> g;
+	std::vector<std::optional<double>> edges;
+	int n, inward, across;
+};
+
+/** The thin sides' model of the print (thinFrameOffset()) applied to
+ * \a out's lines: the frame's width across each from the refined square's
+ * homography (the ratio of the sides' lengths goes as the depth, a
+ * foreshortened width as its square), one blur for the landmark, fitted
+ * first on sides whose frames are wide enough to show it. */
+void applyThinFrameModel(
+	RefinedQuad& out, const std::array<std::optional<ThinSide>, 4>& thin, const CameraModel& cam,
+	double frame_ratio)
+{
+	Quad refined;
+	for (int k = 0; k < 4; ++k)
+	{
+		const auto c = cornerOfSides(out.sides, k);
+		if (!c) return;
+		refined[k] = *c;
+	}
+	// The lines, and so these corners, are in ideal pixels.
+	const FaceMap toPixel{faceToImage(refined), cam, false};
+	std::vector<double> sigmas;
+	std::array<double, 4> offsets{};
+	std::array<bool, 4> done{};
+	for (const bool hold : {false, true})
+	{
+		double sigma = 0;
+		if (hold)
+		{
+			if (sigmas.empty()) break;
+			std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+			sigma = sigmas[sigmas.size() / 2];
+		}
+		for (int side = 0; side < 4; ++side)
+		{
+			if (!thin[side] || done[side]) continue;
+			const ThinSide& t = *thin[side];
+			const Eigen::Vector2d f0 = kFaceCorners[side], f1 = kFaceCorners[(side + 1) % 4];
+			const Eigen::Vector2d in = 0.5 * (f0 + f1), outer = in + frame_ratio * (f0 + f1);
+			const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
+			// Under 2 px the frame never reaches its black: the model cannot
+			// tell it from the margin (the fit's levels and blur wander), and
+			// the peak model's edges stay.
+			if (width < kMinThinModelPx) continue;
+			double fitted_sigma = 0;
+			if (const auto d = thinFrameOffset(t.g, t.n, t.edges, width, sigma, &fitted_sigma))
+			{
+				offsets[side] = *d;
+				done[side] = true;
+				if (!hold && width >= kMinBlurFramePx) sigmas.push_back(fitted_sigma);
+			}
+		}
+	}
+	// Each edge moves by the offset along its profile: the line by as much
+	// across (undistorted and raw pixels differ by the distortion's scale
+	// there, a few percent of a small shift).
+	for (int side = 0; side < 4; ++side)
+		if (done[side])
+		{
+			LineFit& l = out.sides[side];
+			l.c -= l.normal(thin[side]->across) * thin[side]->inward * offsets[side];
+		}
+}
+}  // namespace
+
 std::optional<RefinedQuad> refineQuadrangle(
 	const cv::Mat& bgr, const Quad& coarse, const CameraModel& cam, double min_rise,
-	double frame_ratio, const SubpixelParams& p, double fill_ratio)
+	double frame_ratio, const SubpixelParams& p, double fill_ratio, const SubpixelModels& models)
 {
 	RefinedQuad out;
-	const bool distorted = cam.hasDistortion();
-	const Eigen::Vector2d centre = 0.25 * (coarse[0] + coarse[1] + coarse[2] + coarse[3]);
-	const int W = bgr.cols, H = bgr.rows;
-	const int half = p.search_px + p.reach_px + 2;
 	// The sensor's noise in the centre cell, read once when a side clips.
 	bool noise_read = false;
 	std::optional<double> noise;
@@ -550,117 +621,27 @@ std::optional<RefinedQuad> refineQuadrangle(
 	// with the top but inconclusive.
 	std::array<std::optional<ChannelFillLevel>, 4> channel_level;
 	std::array<bool, 4> undecided{}, channels_agree{};
-	SubpixelParams p_centring = p;
-	p_centring.step_model_peak = false;
-	// Thin sides' profiles and edges for thinFrameOffset().
-	struct ThinSide
-	{
-		std::vector<int> g;
-		std::vector<std::optional<double>> edges;
-		int n, inward, across;
-	};
 	std::array<std::optional<ThinSide>, 4> thin;
 	const auto refineSide = [&](int side, bool retry) -> bool
 	{
-		// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
-		// bottom: BR-BL, left: BL-TL).
-		const Eigen::Vector2d a = coarse[side], b = coarse[(side + 1) % 4];
-		const Eigen::Vector2d ab = b - a;
-		// Scan rows for a mostly vertical side, columns otherwise; the
-		// profile runs across the side along the other axis.
-		const int along = std::abs(ab.y()) >= std::abs(ab.x()) ? 1 : 0;
-		const int across = 1 - along;
-		// Profiles point into the fill, where G rises.
-		const Eigen::Vector2d mid = 0.5 * (a + b);
-		const int inward = centre(across) > mid(across) ? 1 : -1;
-		// Width of the black frame across this side [px], from the extent of
-		// the neighbouring sides: when thin, the frame's outer edge (of
-		// opposite sign) overlaps the response and shifts its centroid
-		// inwards, while the peak barely moves.
-		const Eigen::Vector2d prev_side = coarse[side] - coarse[(side + 3) % 4];
-		const Eigen::Vector2d next_side = coarse[(side + 2) % 4] - coarse[(side + 1) % 4];
-		// Perspective: the frame next to this side is wider or narrower than
-		// the average in the ratio of this side's length (its local scale)
-		// to the mean of it and the opposite side's.
-		const double own = ab.norm(),
-					 opposite = (coarse[(side + 3) % 4] - coarse[(side + 2) % 4]).norm();
-		const double frame_px = frame_ratio * 0.5 *
-								(std::abs(prev_side(across)) + std::abs(next_side(across))) *
-								(own + opposite > 0 ? 2 * own / (own + opposite) : 1.0);
-		const EdgeMode mode =
-			frame_px < p.min_frame_px_centroid ? EdgeMode::Peak : EdgeMode::Centroid;
-		const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
-		const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
-		// First pass: read the profiles (G and -(R + B), across the side,
-		// pointing into the fill).
-		const int n = 2 * half + 1;
-		const int lo = half - p.search_px, hi = half + p.search_px;
-		std::vector<int> g_prof, rb_prof, pos, origin;
-		const size_t max_profiles = static_cast<size_t>(std::max(0.0, s1 - s0 + 1));
-		g_prof.reserve(max_profiles * n);
-		rb_prof.reserve(max_profiles * n);
-		int saturated = 0, clipped = 0;
-		for (int s = static_cast<int>(std::ceil(s0)); s <= static_cast<int>(std::floor(s1)); ++s)
-		{
-			const double cpred = a(across) + (s - a(along)) * ab(across) / ab(along);
-			const int c0 = static_cast<int>(std::lround(cpred));
-			// Profile index i <-> across coordinate c0 + inward * (i - half).
-			const int c_first = c0 - half, c_last = c0 + half;
-			if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 || c_last >= (along == 1 ? W : H))
-				continue;
-			// Sample i at pixel c0 + inward * (i - half) across: a step of
-			// 3 bytes along a row, a row's bytes down a column.
-			const std::ptrdiff_t stride =
-				inward * (along == 1 ? 3 : static_cast<std::ptrdiff_t>(bgr.step[0]));
-			const uint8_t* px = along == 1 ? bgr.ptr<uint8_t>(s) + 3 * (c0 - inward * half)
-										   : bgr.ptr<uint8_t>(c0 - inward * half) + 3 * s;
-			const size_t at = g_prof.size();
-			g_prof.resize(at + n);
-			rb_prof.resize(at + n);
-			int fill_sum = 0;
-			for (int i = 0; i < n; ++i, px += stride)
-			{
-				g_prof[at + i] = px[1];
-				rb_prof[at + i] = -(px[0] + px[2]);
-				if (i >= hi + 2) fill_sum += px[1];
-			}
-			if (fill_sum >= p.saturation_level * (n - hi - 2))
-			{
-				++saturated;
-				// Clipped: G reaches the sensor's top within two samples of
-				// its steepest point, where the peak fit reads it.
-				const int* gp = g_prof.data() + (g_prof.size() - n);
-				const int k = steepestRise(gp, lo, hi);
-				clipped += gp[std::min(n - 1, k + 2)] >= 254;
-			}
-			pos.push_back(s);
-			origin.push_back(c0);
-		}
-		// G saturates on bright fills (the sensor clips at 255), which cuts
-		// the response on the bright side and pulls its centroid towards the
-		// frame; even the derivative's peak moves outwards once the clip
-		// comes within a sample of it (0.2-0.4 px at gain 1.2-1.5). A side is
-		// saturated when most of its profiles' fill sides average above
-		// saturation_level (noise around a fill of exactly 255 does not
-		// count): its edges are then at the G derivative's peak, unless most
-		// profiles reach 255 within two samples of it: then in R + B (dark in
-		// the green fill, unsaturated in the black frame), next to the G
-		// peak, except on thin frames where R + B's outer edge is too close.
-		// (R + B alone would suffer from JPEG's chroma subsampling.) One
-		// estimator per side: mixing them would split the points into two
+		SideProfiles prof = readSideProfiles(bgr, coarse, side, frame_ratio, fill_ratio, p);
+		const int n = prof.n;
+		// A side is saturated when most of its profiles' fill sides average
+		// above saturation_level (noise around a fill of exactly 255 does
+		// not count), clipped when most reach 255 within two samples of
+		// their steepest rise: the locator policy reads both. One locator
+		// per side: mixing them would split the points into two
 		// populations.
-		const int half_count = static_cast<int>(pos.size()) / 2;
-		bool side_saturated = saturated > half_count;
-		const bool side_clipped = clipped > half_count;
+		SideProperties props = measureSide(prof);
 		// Where G clips, restore the clipped samples before the edges are
 		// read (imputeFillLevel(), imputeClippedSide()): the clip cuts the
 		// bright half of the response. The fill band from the coarse line
 		// (within about a pixel of the edge): beyond the edge's blur, short
 		// of the code board.
-		const double fill_px = frame_px * fill_ratio / frame_ratio;
-		const int band0 = half + 3, band1 = half + static_cast<int>(std::floor(fill_px - 3));
-		const ClippedFill band = clippedFill(g_prof, n, band0, band1);
-		bool clips = p.model_clipping && band.count() >= kMinFillSamples &&
+		const int band0 = prof.half + 3,
+				  band1 = prof.half + static_cast<int>(std::floor(prof.fill_px - 3));
+		const ClippedFill band = clippedFill(prof.g, n, band0, band1);
+		bool clips = models.clipping && band.count() >= kMinFillSamples &&
 					 band.fraction() > p.clipped_fraction;
 		bool all_clipped = clips && band.fraction() >= kAllClippedFraction;
 		// A band at 255 throughout need not lie above the clip: a noise-free
@@ -675,97 +656,52 @@ std::optional<RefinedQuad> refineQuadrangle(
 		if (all_clipped && sensorNoise().value_or(kQuietNoise) < kQuietNoise)
 		{
 			auto& c = channel_level[side];
-			if (!retry) c = fillLevelFromChannels(g_prof, rb_prof, n, lo, hi, band0, band1);
+			if (!retry)
+				c = fillLevelFromChannels(prof.g, prof.rb, n, prof.lo, prof.hi, band0, band1);
 			at_top = c && (retry ? c->consistentWithTop() : c->atTop());
 			undecided[side] = !at_top && c && c->consistentWithTop();
 		}
-		if (at_top) clips = all_clipped = side_saturated = false;
+		if (at_top) clips = all_clipped = props.saturated = false;
 		// Part of the fill unclipped: only its noise clips, unless its level
 		// is above the clip somewhere (the transitions clip too: the edge
 		// model's case, below).
 		std::optional<FillLevel> level;
-		if (clips && !all_clipped) level = fitFillLevel(g_prof, n, band0, band1, band);
+		if (clips && !all_clipped) level = fitFillLevel(prof.g, n, band0, band1, band);
 		const bool above_clip = level && level->aboveClip();
 		all_clipped = all_clipped || above_clip;
 		if (level && !above_clip)
 		{
-			imputeFillLevel(g_prof, n, *level);
-			side_saturated = false;
+			imputeFillLevel(prof.g, n, *level);
+			props.saturated = false;
 		}
-		std::vector<std::optional<double>> edges(pos.size());
-		const auto locateAll = [&](bool saturated_path)
-		{
-			for (size_t j = 0; j < pos.size(); ++j)
-			{
-				const int* gp = g_prof.data() + j * n;
-				const int* rbp = rb_prof.data() + j * n;
-				// The edge must have the green fill just inside it (G two
-				// pixels inwards above the mean of R and B by at least a
-				// quarter of G: a printed green through any transfer curve
-				// is, white paper and grey walls are not): the sheet's edge
-				// against a darker wall rises inwards too, a frame width and
-				// a margin outside.
-				const auto greenInside = [&](double e)
-				{
-					const int i = std::min(n - 1, static_cast<int>(std::lround(e)) + 2);
-					return 3 * gp[i] > -2 * rbp[i];
-				};
-				const auto locate = [&](int l, int h) -> std::optional<double>
-				{
-					if (!saturated_path)
-						return locateRisingEdge(
-							gp, n, l, h, min_rise, p, mode, p.model_outer_edge ? frame_px : 0.0);
-					// In R + B the frame's outer edge (white to black) rises
-					// too, a frame width away: search only next to the G
-					// peak and stop the response where it stops falling.
-					// Where R + B places the edge, the G peak only centres
-					// its search: no step model.
-					const bool rb_edge = side_clipped && mode == EdgeMode::Centroid;
-					const auto g_peak = locateRisingEdge(
-						gp, n, l, h, min_rise, rb_edge ? p_centring : p, EdgeMode::Peak,
-						p.model_outer_edge && !side_clipped ? frame_px : 0.0);
-					if (!g_peak) return std::nullopt;
-					std::optional<double> r;
-					const int k = static_cast<int>(std::lround(*g_peak));
-					if (rb_edge)
-						r = locateRisingEdge(
-							rbp, n, k - 1, k + 1, p.min_rise_rb, p, EdgeMode::IsolatedCentroid);
-					return r ? r : g_peak;
-				};
-				std::optional<double> e = locate(lo, hi);
-				if (e && !greenInside(*e))
-				{
-					// Retry inwards of the rejected edge.
-					e = locate(static_cast<int>(std::lround(*e)) + 1, hi);
-					if (e && !greenInside(*e)) e.reset();
-				}
-				edges[j] = e;
-			}
+		SideProperties restored = props;
+		restored.saturated = false;
+		const auto locateAll = [&](const SideProperties& s) {
+			return locateEdges(
+				prof, *makeLocator(chooseLocator(s, p, models), min_rise, p, models));
 		};
-		locateAll(side_saturated);
+		std::vector<std::optional<double>> edges = locateAll(props);
 		// Undecided (a side along the pixel grid, one rounding of R + B all
 		// along): a fill above the top moves G's edges outwards only (its
 		// clip cuts the bright half of their response), by up to a tenth of
 		// a pixel. So where G's edges lie inwards of R + B's (less G's own
 		// rounding) and within R + B's rounding of them, G errs less than
 		// R + B whatever the level, and exactly nothing at the top.
-		if (undecided[side] && !retry && side_saturated && side_clipped &&
-			mode == EdgeMode::Centroid)
+		if (undecided[side] && !retry &&
+			chooseLocator(props, p, models).kind == LocatorKind::Channels)
 		{
-			const auto rb_edges = edges;
-			locateAll(false);
+			const auto g_edges = locateAll(restored);
 			double sum = 0;
 			int count = 0;
 			for (size_t j = 0; j < edges.size(); ++j)
-				if (edges[j] && rb_edges[j])
+				if (g_edges[j] && edges[j])
 				{
-					sum += *edges[j] - *rb_edges[j];
+					sum += *g_edges[j] - *edges[j];
 					++count;
 				}
 			const double rounding = channel_level[side]->rbRoundingPx();
 			const double inwards = count > 0 ? sum / count : -1;
 			channels_agree[side] = count >= 10 && inwards >= -kGRoundingPx && inwards <= rounding;
-			edges = rb_edges;
 		}
 		// All of the fill clipped: restore it from a model of the edge that
 		// knows the clip, then read the edges again as on an unsaturated side.
@@ -775,45 +711,34 @@ std::optional<RefinedQuad> refineQuadrangle(
 		{
 			ClippedSideProfiles clip_side;
 			clip_side.image = &bgr;
-			clip_side.rows = along == 1;
+			clip_side.rows = prof.along == 1;
 			clip_side.n = n;
-			clip_side.inward = inward;
-			clip_side.along = pos;
-			for (const int c0 : origin) clip_side.base.push_back(c0 - inward * half);
+			clip_side.inward = prof.inward;
+			clip_side.along = prof.pos;
+			for (const int c0 : prof.origin) clip_side.base.push_back(c0 - prof.inward * prof.half);
 			if (imputeClippedSide(
-					clip_side, edges, frame_px, fill_px, sensorNoise().value_or(0), g_prof))
-				locateAll(false);
+					clip_side, edges, prof.frame_px, prof.fill_px, sensorNoise().value_or(0),
+					prof.g))
+				edges = locateAll(restored);
 			// Refused (a JPEG's chroma, a sharp edge) where part of the fill
 			// is unclipped: the fill's own model still restores its noise.
 			else if (above_clip)
 			{
-				imputeFillLevel(g_prof, n, *level);
-				locateAll(false);
+				imputeFillLevel(prof.g, n, *level);
+				edges = locateAll(restored);
 			}
 		}
-		// A thin frame (Peak mode) read in G: kept for the side's model
-		// below, once all four lines give the frame's width.
+		// A thin frame read in G by the peak: kept for its print model,
+		// once all four lines give the frame's width.
 		thin[side].reset();
-		if (p.thin_frame_model && mode == EdgeMode::Peak && !side_saturated && !all_clipped)
-			thin[side] = ThinSide{g_prof, edges, n, inward, across};
+		if (models.thin_frame && !all_clipped &&
+			chooseLocator(props, p, models).kind == LocatorKind::Peak && !props.saturated)
+			thin[side] = ThinSide{prof.g, edges, n, prof.inward, prof.across};
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
 		// levels' rounding is one for all its edges.
-		if (p.correct_level_rounding && !clips && !all_clipped)
-			correctLevelRounding(g_prof, n, pos, origin, half, inward, edges);
-		std::vector<Eigen::Vector2d> pts;
-		pts.reserve(pos.size());
-		for (size_t j = 0; j < pos.size(); ++j)
-		{
-			const auto& e = edges[j];
-			if (!e) continue;
-			const double c = origin[j] + inward * (*e - half);
-			Eigen::Vector2d pt =
-				along == 1 ? Eigen::Vector2d(c, pos[j]) : Eigen::Vector2d(pos[j], c);
-			// Lines are straight only without distortion: fit undistorted.
-			if (distorted) pt = cam.undistortPixel(pt);
-			pts.push_back(pt);
-		}
-		auto f = fitLine(std::move(pts), p);
+		if (models.level_rounding && !clips && !all_clipped)
+			correctLevelRounding(prof.g, n, prof.pos, prof.origin, prof.half, prof.inward, edges);
+		auto f = fitLine(edgePoints(prof, edges, cam), p);
 		if (!f) return false;
 		out.sides[side] = std::move(*f);
 		return true;
@@ -831,71 +756,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		if (undecided[side] && (some_at_top || channels_agree[side]) && !refineSide(side, true))
 			return std::nullopt;
 	if (std::any_of(thin.begin(), thin.end(), [](const auto& t) { return t.has_value(); }))
-	{
-		// The thin sides' model of the print (thinFrameOffset()): the
-		// frame's width across each from the refined square's homography
-		// (the ratio of the sides' lengths goes as the depth, a
-		// foreshortened width as its square), one blur for the landmark,
-		// fitted first on sides whose profiles' phases spread over the pixel.
-		Quad refined;
-		bool ok = true;
-		for (int k = 0; k < 4 && ok; ++k)
-		{
-			const auto c = cornerOfSides(out.sides, k);
-			ok = c.has_value();
-			if (ok) refined[k] = *c;
-		}
-		if (ok)
-		{
-			// The lines, and so these corners, are in ideal pixels.
-			const FaceMap toPixel{faceToImage(refined), cam, false};
-			std::vector<double> sigmas;
-			std::array<double, 4> offsets{};
-			std::array<bool, 4> done{};
-			for (const bool hold : {false, true})
-			{
-				double sigma = 0;
-				if (hold)
-				{
-					if (sigmas.empty()) break;
-					std::nth_element(
-						sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
-					sigma = sigmas[sigmas.size() / 2];
-				}
-				for (int side = 0; side < 4; ++side)
-				{
-					if (!thin[side] || done[side]) continue;
-					const ThinSide& t = *thin[side];
-					const Eigen::Vector2d f0 = kFaceCorners[side],
-										  f1 = kFaceCorners[(side + 1) % 4];
-					const Eigen::Vector2d in = 0.5 * (f0 + f1),
-										  outer = in + frame_ratio * (f0 + f1);
-					const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
-					// Under 2 px the frame never reaches its black: the
-					// model cannot tell it from the margin (the fit's levels
-					// and blur wander), and the peak model's edges stay.
-					if (width < kMinThinModelPx) continue;
-					double fitted_sigma = 0;
-					if (const auto d =
-							thinFrameOffset(t.g, t.n, t.edges, width, sigma, &fitted_sigma))
-					{
-						offsets[side] = *d;
-						done[side] = true;
-						if (!hold && width >= kMinBlurFramePx) sigmas.push_back(fitted_sigma);
-					}
-				}
-			}
-			// Each edge moves by the offset along its profile: the line by
-			// as much across (undistorted and raw pixels differ by the
-			// distortion's scale there, a few percent of a small shift).
-			for (int side = 0; side < 4; ++side)
-				if (done[side])
-				{
-					LineFit& l = out.sides[side];
-					l.c -= l.normal(thin[side]->across) * thin[side]->inward * offsets[side];
-				}
-		}
-	}
+		applyThinFrameModel(out, thin, cam, frame_ratio);
 	if (!cornersFromSides(out, cam)) return std::nullopt;
 	// The refinement must stay near the coarse corner.
 	for (int k = 0; k < 4; ++k)

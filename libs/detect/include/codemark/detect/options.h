@@ -156,61 +156,22 @@ struct SubpixelParams
 	 * frame) and, failing that, at the G derivative's peak. Noise on a fill of
 	 * exactly 255 averages below 254.5. */
 	double saturation_level = 254.5;
-	/** On sides where G clips, restore the clipped samples (from the fill's
-	 * censored noise distribution, or where all of the fill clips from an
-	 * edge model of B, G and R fitted with them censored), then read the
-	 * edges as on an unsaturated side (imputeClippedSide() in stages.h): the
-	 * clip cuts the bright half of the response and the estimates above make
-	 * each edge move outwards by 0.012 px where only a fill's noise clips,
-	 * 0.05 px at gains of 1.1-1.6 and up to 0.5 px on thin frames. */
-	bool model_clipping = true;
-	/** ... on sides where more than this fraction of the fill band's samples
+	/** On sides where more than this fraction of the fill band's samples
 	 * (from the coarse line, beyond the edge's blur and short of the code
-	 * board) are at 255. A fill at exactly the top clips half of them through
-	 * its noise; a JPEG's ringing next to an unclipped fill a few. */
+	 * board) are at 255, the clipped samples are restored (from the fill's
+	 * censored noise distribution, or where all of the fill clips from an
+	 * edge model of B, G and R fitted with them censored) before the edges
+	 * are read: the clip cuts the bright half of the response, which moves
+	 * each edge outwards by 0.012 px where only a fill's noise clips,
+	 * 0.05 px at gains of 1.1-1.6 and up to 0.5 px on thin frames. A fill
+	 * at exactly the top clips half of them through its noise; a JPEG's
+	 * ringing next to an unclipped fill a few. */
 	double clipped_fraction = 0.25;
 	/** Where the black frame is narrower than this across a side [px], its
 	 * outer edge overlaps the inner edge's response: the edge is then taken
-	 * at the derivative's peak (Gaussian through three samples), which the
-	 * neighbour shifts far less than the centroid. */
+	 * at the derivative's peak, with a model of the outer edge's lobe
+	 * removed, which the neighbour shifts far less than the centroid. */
 	double min_frame_px_centroid = 6;
-	/** On such thin frames, remove a Gaussian model of the outer edge's
-	 * derivative lobe (a frame width outside, as wide as the inner edge's,
-	 * its height read from the profile) before locating the peak: that
-	 * lobe's tail pulls the peak inwards by 0.2-0.5 px when the frame is
-	 * 1.6-2.3 px wide (5 m at 45-60 deg). */
-	bool model_outer_edge = true;
-	/** ... and then shift each side whose frame is 2-6 px wide by the
-	 * offset that a fit of all its profiles together with a model of the
-	 * whole print across it (wall, quiet margin, frame, fill; the frame's
-	 * width from the refined square, one blur for the landmark) gives
-	 * (detect::thinFrameOffset()). The peak model knows the frame's outer
-	 * edge but not the margin's: where the spec's 5 mm margin is under a
-	 * pixel, the wall's edge to it cancels part of the frame's lobe, and
-	 * the edges lie 0.05-0.1 px inwards. On the accuracy map it takes the
-	 * position error from 2 to 5 m from 30.2 to 21.8 mm, and codemark is
-	 * then no worse than AprilTag 3 in any cell; the shipped C_P is
-	 * calibrated with it (pipeline.h, docs/benchmarks/pose.md). */
-	bool thin_frame_model = true;
-	/** Where the black frame reads narrower than the square's homography
-	 * says on every side (by 0.2 px or more: a camera's transfer curve, or
-	 * a clip, bends both of its edges towards the black), place each side
-	 * on the frame's midline, read between its inner and outer edges, less
-	 * half the frame's width: the bend, a clip and printers' dot gain
-	 * cancel there.
-	 * Sides whose quiet margin is narrower than a pixel, or than the
-	 * edge's blur at half maximum, keep their single-edge line. */
-	bool frame_midline = true;
-	/** Refine the derivative's peak with the exact response of a
-	 * pixel-integrated Gaussian step (its position, blur and height from
-	 * the three samples) instead of the log-parabola's Gaussian, which
-	 * errs with the edge's phase in its pixel on sharp edges. */
-	bool step_model_peak = true;
-	/** On a noise-free sharp side (one mixed sample a profile between
-	 * levels shared by all of them), fit the rounding of the levels' contrast
-	 * with the line: it is one for the whole side and tilts the line where
-	 * the edge crosses a pixel boundary. Noisy images never qualify. */
-	bool correct_level_rounding = true;
 	/** Smallest slope of R + B accepted on a saturated profile [grey levels
 	 * per px]. */
 	double min_rise_rb = 4;

@@ -35,8 +35,8 @@ namespace codemark::pipeline
  * them, compares P from the detected corners with P from the renderer's
  * exact corners, and fits the model by maximum likelihood (--averaged:
  * clipped and unclipped sides in one model; 1027 detections of 1030
- * renders in view, detector of 2026-12-02 with the thin-frame model,
- * SubpixelParams::thin_frame_model):
+ * renders in view, the detector with the thin-frame model,
+ * detect::thinFrameOffset()):
  * - x1, x2 (whole-edge line fits): 0.0238 px, growing as (30 px / apparent
  *   width)^1.75 with 0.020 px at 30 px (a small landmark's frame is a few
  *   pixels wide and its two blurred edges pull on each other); correlated
@@ -47,8 +47,8 @@ namespace codemark::pipeline
  * Normalised variances on the calibration set 1.037 (x), 0.962 (y). The
  * detector restores clipped fills (detect::imputeClippedSide()), fits a thin
  * frame's edge with the exact response of a pixel-integrated step
- * (SubpixelParams::step_model_peak) and, since the eighth session, a thin
- * side's profiles with a model of the whole print (thin_frame_model). With
+ * (detect::EdgeMode::Peak) and a thin side's profiles with a model of the
+ * whole print (detect::thinFrameOffset()). With
  * that model on, the previous fit (to 75 deg: 0.0213 / 0.020 px, growth
  * 0.030 / 0.035, exponents 1.5 / 1.5) left the simulated loops' EKF
  * pessimistic (NEES 2.35), and so did its refit to 75 deg (2.48): views

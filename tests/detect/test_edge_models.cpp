@@ -1,0 +1,288 @@
+// The sub-pixel stage's parts on their own: each edge locator on synthetic
+// profiles with a known edge, through the transfer curves, blur and
+// sharpening of the camera pipeline; the policy's choice per side kind.
+#include "edge_models.h"
+
+#include <codemark/sim/camera_pipeline.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace codemark;
+using namespace codemark::detect;
+
+namespace
+{
+/** A print across a side in linear light [full scale]: per channel (B, G,
+ * R), the wall up to the frame's outer edge, the black frame up to the
+ * inner edge at x0, the fill beyond. */
+struct Print
+{
+	std::array<double, 3> wall, black, fill;
+	double frame_px;
+};
+
+/** The sensor's view of \a print: per channel, blurred by a Gaussian of \a
+ * sigma, integrated over each pixel, clipped at the sensor's top, then
+ * sharpened by an unsharp mask (\a amount, radius 1 px) and encoded
+ * through \a curve to 8 bits: the camera-pipeline's order. Returns the G
+ * profile and -(R + B), \a n samples each. */
+void cameraProfile(
+	const Print& print, double x0, double sigma, double amount, sim::Transfer curve, int n,
+	std::vector<int>& g, std::vector<int>& rb)
+{
+	const auto Phi = [&](double x) { return 0.5 * (1 + std::erf(x / (std::sqrt(2.0) * sigma))); };
+	std::array<std::vector<double>, 3> lin;
+	for (int c = 0; c < 3; ++c)
+	{
+		lin[c].assign(n, 0);
+		for (int i = 0; i < n; ++i)
+		{
+			double s = 0;
+			constexpr int kSub = 64;
+			for (int k = 0; k < kSub; ++k)
+			{
+				const double x = i - 0.5 + (k + 0.5) / kSub;
+				s += print.wall[c] +
+					 (print.black[c] - print.wall[c]) * Phi(x - (x0 - print.frame_px)) +
+					 (print.fill[c] - print.black[c]) * Phi(x - x0);
+			}
+			lin[c][i] = std::min(1.0, s / kSub);
+		}
+		if (amount > 0)
+		{
+			cv::Mat m(1, n, CV_64F, lin[c].data()), b;
+			cv::GaussianBlur(m, b, cv::Size(0, 0), 1.0, 0, cv::BORDER_REPLICATE);
+			const std::vector<double> base = lin[c];
+			for (int i = 0; i < n; ++i)
+				lin[c][i] = base[i] + amount * (base[i] - b.at<double>(0, i));
+		}
+	}
+	const auto encode = [&](double v)
+	{
+		return static_cast<int>(
+			std::lround(255 * sim::encodeTransfer(std::clamp(v, 0.0, 1.0), curve)));
+	};
+	g.resize(n);
+	rb.resize(n);
+	for (int i = 0; i < n; ++i)
+	{
+		g[i] = encode(lin[1][i]);
+		rb[i] = -(encode(lin[0][i]) + encode(lin[2][i]));
+	}
+}
+
+/** The three side kinds the policy tells apart, and the locator each one
+ * gets: a wide frame (the centroid), a thin one (the peak with the outer
+ * edge's lobe), a fill above the sensor's top on a wide frame (R + B next
+ * to G's peak). */
+struct Case
+{
+	const char* name;
+	Print print;
+	LocatorChoice choice;
+};
+std::vector<Case> cases()
+{
+	const std::array<double, 3> wall{0.6, 0.6, 0.6}, black{0.02, 0.02, 0.02};
+	return {
+		{"wide", {wall, black, {0.05, 0.7, 0.1}, 12}, {LocatorKind::Centroid, 0}},
+		{"thin", {wall, black, {0.05, 0.7, 0.1}, 3}, {LocatorKind::Peak, 3}},
+		{"clipped", {wall, {0.25, 0.02, 0.25}, {0.0, 1.4, 0.0}, 12}, {LocatorKind::Channels, 0}}};
+}
+
+/** Mean signed error [px, positive into the fill] of \a locator over
+ * sub-pixel positions of the edge, and the largest error. */
+struct Errors
+{
+	double mean = 0, worst = 0;
+};
+Errors locatorErrors(
+	const EdgeLocator& locator, const Print& print, double sigma, double amount,
+	sim::Transfer curve)
+{
+	const SubpixelParams p;
+	const int half = p.search_px + p.reach_px + 2, n = 2 * half + 1;
+	std::vector<int> g, rb;
+	Errors e;
+	int count = 0;
+	for (double x0 = half - 0.5; x0 < half + 0.5; x0 += 0.05, ++count)
+	{
+		cameraProfile(print, x0, sigma, amount, curve, n, g, rb);
+		const auto at =
+			locator.locate(g.data(), rb.data(), n, half - p.search_px, half + p.search_px);
+		EXPECT_TRUE(at.has_value());
+		if (!at) return {1e9, 1e9};
+		e.mean += *at - x0;
+		e.worst = std::max(e.worst, std::abs(*at - x0));
+	}
+	e.mean /= count;
+	return e;
+}
+}  // namespace
+
+// In linear light each locator reads its side kind's edge exactly, up to
+// the profile's 8-bit rounding (and R + B's smaller contrast), whatever the
+// blur, and with an unsharp mask, which is odd-symmetric about the edge.
+// Through a camera's transfer curve (after the blur) each channel's edge
+// moves towards that channel's dark side: G's towards the black frame (the
+// square looks larger), R + B's into the fill. That bend is what the
+// frame's midline (centreOnFrame()) cancels and no single-edge locator can.
+TEST(EdgeModels, EveryLocatorThroughCurvesBlurAndSharpening)
+{
+	const SubpixelParams p;
+	for (const auto& c : cases())
+	{
+		const auto locator = makeLocator(c.choice, 5, p);
+		for (const double sigma : {0.5, 0.8, 1.2})
+			for (const double amount : {0.0, 0.5})
+				for (const auto curve :
+					 {sim::Transfer::Linear, sim::Transfer::SRGB, sim::Transfer::Gamma,
+					  sim::Transfer::Filmic})
+				{
+					const Errors e = locatorErrors(*locator, c.print, sigma, amount, curve);
+					const std::string what =
+						std::string(c.name) + " sigma " + std::to_string(sigma) + " sharpen " +
+						std::to_string(amount) + " " + sim::transferName(curve);
+					std::printf(
+						"[ locator ] %-8s %-9s sigma %.1f sharpen %.1f %-7s mean %+.4f worst "
+						"%.4f\n",
+						c.name, locatorName(c.choice.kind), sigma, amount, sim::transferName(curve),
+						e.mean, e.worst);
+					if (curve == sim::Transfer::Linear)
+					{
+						EXPECT_LE(std::abs(e.mean), 0.025) << what;
+						EXPECT_LE(e.worst, 0.075) << what;
+					}
+					else if (c.choice.kind != LocatorKind::Channels)
+					{
+						EXPECT_LT(e.mean, -0.1) << what;
+					}
+					else if (sigma <= 0.5)
+					{
+						EXPECT_GT(e.mean, 0.1) << what;
+					}
+				}
+	}
+}
+
+namespace
+{
+/** An axis-aligned print on a wall, as a camera without a transfer curve
+ * sees it: the inner square [o, o + side) px, a frame \a frame px wide
+ * around it, fill G \a fill_g (R and B 5, darker than the frame; above 255 the sensor clips
+ * it), blurred by 0.8 px; and the
+ * coarse quadrangle of its inner corners, off by a few tenths of a pixel
+ * as stage 6 leaves them. */
+struct PrintImage
+{
+	cv::Mat bgr;
+	Quad coarse;
+};
+PrintImage printImage(int side, int frame, int fill_g)
+{
+	const int o = 2 * frame + 20, size = side + 2 * o;
+	PrintImage out;
+	cv::Mat light(size, size, CV_32FC3, cv::Scalar(200, 200, 200));
+	cv::rectangle(
+		light, cv::Rect(o - frame, o - frame, side + 2 * frame, side + 2 * frame),
+		cv::Scalar(25, 25, 25), cv::FILLED);
+	cv::rectangle(light, cv::Rect(o, o, side, side), cv::Scalar(5, fill_g, 5), cv::FILLED);
+	cv::GaussianBlur(light, light, cv::Size(0, 0), 0.8);
+	light.convertTo(out.bgr, CV_8UC3);	// rounds and clips at 255
+	const double a = o - 0.5, b = o + side - 0.5;
+	out.coarse = {
+		Eigen::Vector2d(a + 0.3, a - 0.2), Eigen::Vector2d(b - 0.2, a + 0.3),
+		Eigen::Vector2d(b + 0.2, b - 0.3), Eigen::Vector2d(a - 0.3, b + 0.2)};
+	return out;
+}
+}  // namespace
+
+// The policy on each side kind as readSideProfiles() reads it from an
+// image: what it measures (the frame's width, saturation, the clip at the
+// edge) and the locator it picks, on every side.
+TEST(EdgeModels, PolicyPicksTheLocatorFromTheSidesProperties)
+{
+	const SubpixelParams p;
+	const double frame_ratio = 0.125, fill_ratio = 35.0 / 160;
+	struct Expected
+	{
+		const char* name;
+		int side, frame, fill_g;
+		bool saturated, clipped;
+		LocatorKind kind;
+		bool outer_edge;  // the Peak locator models the outer edge
+		/** The locator's largest error alone [px]. On a thin frame whose
+		 * fill clips, the clip cuts the response's bright half and the
+		 * peak moves outwards: the clip's imputation (a side model, run
+		 * before the locator in refineQuadrangle()) restores it. */
+		double locator_px;
+	};
+	for (const Expected& x : std::vector<Expected>{
+			 {"wide frame", 80, 10, 180, false, false, LocatorKind::Centroid, false, 0.05},
+			 {"thin frame", 32, 4, 180, false, false, LocatorKind::Peak, true, 0.05},
+			 {"clipped fill, wide frame", 80, 10, 400, true, true, LocatorKind::Channels, false,
+			  0.05},
+			 {"clipped fill, thin frame", 32, 4, 400, true, true, LocatorKind::Peak, false, 0.5}})
+	{
+		const PrintImage img = printImage(x.side, x.frame, x.fill_g);
+		for (int side = 0; side < 4; ++side)
+		{
+			SCOPED_TRACE(std::string(x.name) + ", side " + std::to_string(side));
+			const SideProfiles prof =
+				readSideProfiles(img.bgr, img.coarse, side, frame_ratio, fill_ratio, p);
+			EXPECT_GE(prof.count(), static_cast<size_t>(x.side - 2 * p.corner_margin_px - 1));
+			const SideProperties s = measureSide(prof);
+			EXPECT_NEAR(s.frame_px, x.frame, 0.1 * x.frame);
+			EXPECT_EQ(s.saturated, x.saturated);
+			EXPECT_EQ(s.clipped, x.clipped);
+			const LocatorChoice c = chooseLocator(s, p);
+			EXPECT_EQ(c.kind, x.kind) << locatorName(c.kind);
+			if (x.outer_edge)
+			{
+				EXPECT_DOUBLE_EQ(c.outer_edge_px, s.frame_px);
+			}
+			else
+			{
+				EXPECT_EQ(c.outer_edge_px, 0);
+			}
+			// The outer edge's model switched off for an experiment.
+			SubpixelModels plain;
+			plain.outer_edge = false;
+			EXPECT_EQ(chooseLocator(s, p, plain).outer_edge_px, 0);
+			// The chosen locator finds the inner edge, half a pixel before
+			// the first fill pixel, in every profile.
+			const auto edges = locateEdges(prof, *makeLocator(c, 5, p));
+			int found = 0;
+			double worst = 0;
+			const double o = 2 * x.frame + 20 - 0.5, b = o + x.side;
+			for (size_t j = 0; j < prof.count(); ++j)
+				if (edges[j])
+				{
+					++found;
+					const Eigen::Vector2d pt = prof.point(j, *edges[j]);
+					const double across = pt(prof.across);
+					worst = std::max(worst, std::min(std::abs(across - o), std::abs(across - b)));
+				}
+			EXPECT_EQ(found, static_cast<int>(prof.count()));
+			EXPECT_LT(worst, x.locator_px);
+		}
+		// The whole stage, side models and line fits included, puts the
+		// corners on the print's.
+		const auto r = refineQuadrangle(img.bgr, img.coarse, CameraModel(), 5, frame_ratio, p);
+		ASSERT_TRUE(r) << x.name;
+		const double a = 2 * x.frame + 20 - 0.5, b = a + x.side;
+		const Quad truth{
+			Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b),
+			Eigen::Vector2d(a, b)};
+		for (int k = 0; k < 4; ++k)
+			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.05) << x.name << ", corner " << k;
+	}
+}
