@@ -81,19 +81,22 @@ std::vector<Eigen::Vector2d> sidePolyline(
 }
 }  // namespace
 
-std::optional<FrameMidline> frameMidlineSide(
+std::optional<FrameSide> readFrameSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& cam, double min_rise,
-	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles)
+	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
+	double offset)
 {
 	const bool distorted = cam.hasDistortion();
 	const FaceMap map{faceToImage(q.corners_ideal), cam, distorted};
 	const Eigen::Vector2d a = q.corners_raw[side], b = q.corners_raw[(side + 1) % 4];
 	const Eigen::Vector2d ab = b - a;
-	const int along = std::abs(ab.y()) >= std::abs(ab.x()) ? 1 : 0;
+	FrameSide out;
+	out.side = side;
+	const int along = out.along = std::abs(ab.y()) >= std::abs(ab.x()) ? 1 : 0;
 	const int across = 1 - along;
 	const Eigen::Vector2d centre =
 		0.25 * (q.corners_raw[0] + q.corners_raw[1] + q.corners_raw[2] + q.corners_raw[3]);
-	const int inward = centre(across) > 0.5 * (a(across) + b(across)) ? 1 : -1;
+	const int inward = out.inward = centre(across) > 0.5 * (a(across) + b(across)) ? 1 : -1;
 	const Eigen::Vector2d f0 = kFaceCorners[side], f1 = kFaceCorners[(side + 1) % 4];
 	const auto inner = sidePolyline(map, f0, f1, 0, along);
 	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, along);
@@ -106,24 +109,15 @@ std::optional<FrameMidline> frameMidlineSide(
 	const int W = bgr.cols, H = bgr.rows;
 	const double s0 = std::min(a(along), b(along)) + p.corner_margin_px;
 	const double s1 = std::max(a(along), b(along)) - p.corner_margin_px;
-	// Per profile: where it lies, both edges, the predicted width and the
-	// levels next to the edges.
-	struct Reading
-	{
-		int s, base;
-		double e_in, e_out, width;
-		int dark, fill, sheet;
-		double blur_var;  //!< the inner edge's blur variance [px^2]
-	};
 	double min_margin = std::numeric_limits<double>::infinity();
-	std::vector<Reading> reads;
+	auto& reads = out.reads;
 	std::vector<int> v, vr;
 	const int first = static_cast<int>(std::ceil(s0)), last = static_cast<int>(std::floor(s1));
 	// An odd stride, so that the profiles take every phase of a Bayer
 	// mosaic's rows and of a JPEG's blocks.
 	const int stride = std::max(1, (last - first + 1) / std::max(1, max_profiles)) | 1;
 	size_t at_inner = 0, at_outer = 0, at_sheet = 0;
-	for (int s = first; s <= last; s += stride)
+	for (int s = first + static_cast<int>(offset * stride); s <= last; s += stride)
 	{
 		const auto c_in = acrossAt(inner, along, s, at_inner),
 				   c_out = acrossAt(outer, along, s, at_outer),
@@ -171,7 +165,7 @@ std::optional<FrameMidline> frameMidlineSide(
 		const double e_out = n - 1 - *e_out_r;
 		const double measured = *e_in - e_out;
 		if (measured < 0.5 * width || measured > 1.5 * width) continue;
-		Reading r{s, base, *e_in, e_out, width, 255, 0, 0, 0};
+		FrameReading r{s, base, *e_in, e_out, width, 255, 0, 0, 0};
 		{
 			// The inner edge's blur: the spread of its central differences
 			// (positive ones, within a frame width), less the difference's
@@ -207,6 +201,13 @@ std::optional<FrameMidline> frameMidlineSide(
 		const double blur = std::sqrt(std::max(0.0, var[var.size() / 2]));
 		if (min_margin < kMarginBlurs * blur) return std::nullopt;
 	}
+	return out;
+}
+
+std::optional<FrameMidline> midlineOfSide(
+	const FrameSide& f, const RefinedQuad& q, const CameraModel& cam, double frame_ratio,
+	const SubpixelParams& p)
+{
 	// The bend of an edge grows with its contrast: through sRGB or a gamma
 	// of 1.8-2.6, as the square root of the encoded step from the same
 	// black within 5% (fill and sheet levels from 0.3 to 1 in linear
@@ -214,58 +215,112 @@ std::optional<FrameMidline> frameMidlineSide(
 	const auto median = [&](auto level)
 	{
 		std::vector<int> x;
-		x.reserve(reads.size());
-		for (const auto& r : reads) x.push_back(level(r));
+		x.reserve(f.reads.size());
+		for (const auto& r : f.reads) x.push_back(level(r));
 		std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
 		return std::max(1, x[x.size() / 2]);
 	};
-	const double root_in = std::sqrt(median([](const Reading&r) { return r.fill - r.dark; })),
-				 root_out = std::sqrt(median([](const Reading&r) { return r.sheet - r.dark; }));
+	const double root_in = std::sqrt(median([](const FrameReading&r) { return r.fill - r.dark; })),
+				 root_out =
+					 std::sqrt(median([](const FrameReading&r) { return r.sheet - r.dark; }));
 	const double share_in = root_in / (root_in + root_out);
+	// The frame's width at each reading from q's homography.
+	const bool distorted = cam.hasDistortion();
+	const FaceMap map{faceToImage(q.corners_ideal), cam, distorted};
+	const Eigen::Vector2d f0 = kFaceCorners[f.side], f1 = kFaceCorners[(f.side + 1) % 4];
+	const auto inner = sidePolyline(map, f0, f1, 0, f.along);
+	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, f.along);
+	size_t at_inner = 0, at_outer = 0;
 	std::vector<Eigen::Vector2d> pts;
 	std::vector<double> shifts;
-	for (const auto& r : reads)
+	pts.reserve(f.reads.size());
+	shifts.reserve(f.reads.size());
+	for (const auto& r : f.reads)
 	{
-		const double shift = share_in * (r.width - (r.e_in - r.e_out));
+		const auto c_in = acrossAt(inner, f.along, r.s, at_inner),
+				   c_out = acrossAt(outer, f.along, r.s, at_outer);
+		if (!c_in || !c_out) continue;
+		const double width = f.inward * (*c_in - *c_out);
+		const double shift = share_in * (width - (r.e_in - r.e_out));
 		shifts.push_back(shift);
-		const double c = r.base + inward * (r.e_in + shift);
-		Eigen::Vector2d pt = along == 1 ? Eigen::Vector2d(c, r.s) : Eigen::Vector2d(r.s, c);
+		const double c = r.base + f.inward * (r.e_in + shift);
+		Eigen::Vector2d pt = f.along == 1 ? Eigen::Vector2d(c, r.s) : Eigen::Vector2d(r.s, c);
 		if (distorted) pt = cam.undistortPixel(pt);
 		pts.push_back(pt);
 	}
-	auto f = fitLine(std::move(pts), p);
-	if (!f) return std::nullopt;
+	if (shifts.empty()) return std::nullopt;
+	auto line = fitLine(std::move(pts), p);
+	if (!line) return std::nullopt;
 	std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
-	return FrameMidline{std::move(*f), shifts[shifts.size() / 2]};
+	return FrameMidline{std::move(*line), shifts[shifts.size() / 2]};
+}
+
+std::optional<FrameMidline> frameMidlineSide(
+	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& cam, double min_rise,
+	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles)
+{
+	const auto f =
+		readFrameSide(bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p, max_profiles);
+	if (!f) return std::nullopt;
+	return midlineOfSide(*f, q, cam, frame_ratio, p);
 }
 
 void centreOnFrame(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& cam, double min_rise, double frame_ratio,
 	double margin_ratio, const SubpixelParams& p)
 {
-	for (int pass = 0; pass < 2; ++pass)
+	// The first pass decides on a few profiles a side (kDecisionProfiles):
+	// where one side's frame reads as wide as the homography says, within
+	// the midline's own scatter, or wider (printers' dot gain widens it),
+	// there is no bend to undo, and the single-edge models (exact in
+	// linear light, with their restoration of a clipped fill) stay. A
+	// transfer curve bends every side of the landmark alike.
+	std::array<std::optional<FrameSide>, 4> read;
+	RefinedQuad next = q;
+	int count = 0;
+	for (int side = 0; side < 4; ++side)
 	{
-		RefinedQuad next = q;
-		int count = 0;
-		for (int side = 0; side < 4; ++side)
-		{
-			auto m = frameMidlineSide(
-				bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p,
-				pass == 0 ? kDecisionProfiles : kLineProfiles);
-			if (!m) continue;
-			// A transfer curve bends every side of the landmark alike:
-			// where one side's frame reads as wide as the homography says,
-			// within the midline's own scatter, or wider (printers' dot gain
-			// widens it), there is no bend to undo, and the single-edge
-			// models (exact in linear light, with their restoration of a
-			// clipped fill) stay.
-			if (pass == 0 && m->shift_px < kMinShiftPx) return;
-			next.sides[side] = std::move(m->line);
-			++count;
-		}
-		if (count == 0 || !cornersFromSides(next, cam)) return;
-		q = std::move(next);
+		read[side] = readFrameSide(
+			bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p, kDecisionProfiles);
+		if (!read[side]) continue;
+		auto m = midlineOfSide(*read[side], q, cam, frame_ratio, p);
+		if (!m) continue;
+		if (m->shift_px < kMinShiftPx) return;
+		next.sides[side] = std::move(m->line);
+		++count;
 	}
+	if (count == 0 || !cornersFromSides(next, cam)) return;
+	// The second pass reads each such side on more profiles between the
+	// first's, around the first pass's square, and places every reading's
+	// midline with that square's frame widths: the widths, not the edges,
+	// depend on the square.
+	const RefinedQuad first = next;
+	count = 0;
+	for (int side = 0; side < 4; ++side)
+	{
+		if (!read[side]) continue;
+		if (const auto more = readFrameSide(
+				bgr, first, side, cam, min_rise, frame_ratio, margin_ratio, p,
+				kLineProfiles - kDecisionProfiles, 0.5))
+		{
+			auto& r = read[side]->reads;
+			r.insert(r.end(), more->reads.begin(), more->reads.end());
+			std::sort(
+				r.begin(), r.end(),
+				[](const FrameReading& x, const FrameReading& y) { return x.s < y.s; });
+			r.erase(
+				std::unique(
+					r.begin(), r.end(),
+					[](const FrameReading& x, const FrameReading& y) { return x.s == y.s; }),
+				r.end());
+		}
+		auto m = midlineOfSide(*read[side], first, cam, frame_ratio, p);
+		if (!m) continue;
+		next.sides[side] = std::move(m->line);
+		++count;
+	}
+	if (count == 0 || !cornersFromSides(next, cam)) return;
+	q = std::move(next);
 }
 
 }  // namespace codemark::detect

@@ -456,13 +456,44 @@ struct FrameMidline
 	double shift_px = 0;
 };
 
-/** One side of \a q re-fitted on the black frame's midline: per profile,
- * the inner and the outer edge of the frame (the same locator, mirrored),
- * the missing width shared between them in the ratio of their bends, the
- * inner edge moved inwards by its share. Nullopt where the quiet margin is
- * unresolved (\a margin_ratio: its width over the inner side) or too few
- * profiles read both edges. Reads at most about \a max_profiles profiles,
- * evenly spread along the side. */
+/** One profile across a side's black frame (readFrameSide()). */
+struct FrameReading
+{
+	int s, base;  //!< along coordinate; across coordinate of sample 0 [px]
+	/** The inner and outer edges [samples from base, into the fill] and
+	 * the frame's width the reading's square predicted [px]. */
+	double e_in, e_out, width;
+	int dark, fill, sheet;	//!< G of the frame, the fill and the sheet
+	double blur_var;  //!< the inner edge's blur variance [px^2]
+};
+
+/** A side's frame as readFrameSide() reads it. */
+struct FrameSide
+{
+	int side = 0, along = 1, inward = 1;
+	std::vector<FrameReading> reads;  //!< ordered along
+};
+
+/** Side \a side's black frame read across, in at most about \a
+ * max_profiles profiles evenly spread along it (an odd stride, the first
+ * \a offset strides from the side's start): per profile the inner and the
+ * outer edge of the frame (the same locator, mirrored) and the levels next
+ * to them. Nullopt where the quiet margin is unresolved (\a margin_ratio:
+ * its width over the inner side) or no profile reads both edges. */
+std::optional<FrameSide> readFrameSide(
+	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
+	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
+	double offset = 0);
+
+/** The side's line on the frame's midline, the frame's width at each
+ * reading from \a q's homography: the missing width shared between the
+ * edges in the ratio of their bends (the square roots of their contrasts),
+ * the inner edge moved inwards by its share. */
+std::optional<FrameMidline> midlineOfSide(
+	const FrameSide& f, const RefinedQuad& q, const CameraModel& camera, double frame_ratio,
+	const SubpixelParams& p);
+
+/** readFrameSide() and midlineOfSide() on the same square. */
 std::optional<FrameMidline> frameMidlineSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles);
@@ -470,9 +501,9 @@ std::optional<FrameMidline> frameMidlineSide(
 /** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
  * on every side it reads (the frame reads narrower than the homography's
  * width all round: a transfer curve or a clip bent its edges), each side
- * goes to the frame's midline, twice (the second pass with the frame's
- * width from the first's square), and the corners follow; otherwise \a q
- * stays as it is. */
+ * goes to the frame's midline, twice (the second time with the frame's
+ * widths from the first's square, on the same readings), and the corners
+ * follow; otherwise \a q stays as it is. */
 void centreOnFrame(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p);
