@@ -341,6 +341,35 @@ cv::Mat mosaic(const cv::Mat& img, BayerLayout layout)
 	return raw;
 }
 
+namespace
+{
+/** The rows by which OpenCV's VNG demosaicing moves the image down (its
+ * output row v holds the scene's row v + 2 in OpenCV up to 4.11, opencv
+ * issue #27225; none once fixed), measured once on a horizontal edge
+ * against bilinear demosaicing, so that demosaicRaw() undoes it on any
+ * OpenCV. */
+int vngRowShift()
+{
+	static const int shift = []
+	{
+		cv::Mat raw(32, 16, CV_8U, cv::Scalar(40));
+		raw.rowRange(16, 32).setTo(200);
+		cv::Mat vng, bilinear;
+		cv::demosaicing(raw, vng, cv::COLOR_BayerBG2BGR_VNG);
+		cv::demosaicing(raw, bilinear, cv::COLOR_BayerBG2BGR);
+		// The edge's row: where G's column 8 first reaches halfway.
+		const auto edgeRow = [](const cv::Mat& img)
+		{
+			for (int v = 0; v < img.rows; ++v)
+				if (img.at<cv::Vec3b>(v, 8)[1] >= 120) return v;
+			return img.rows;
+		};
+		return edgeRow(bilinear) - edgeRow(vng);
+	}();
+	return shift;
+}
+}  // namespace
+
 cv::Mat demosaicRaw(const cv::Mat& raw, BayerLayout layout, Demosaic method)
 {
 	CV_Assert(raw.type() == CV_32F && layout != BayerLayout::None);
@@ -350,6 +379,16 @@ cv::Mat demosaicRaw(const cv::Mat& raw, BayerLayout layout, Demosaic method)
 	cv::Mat q, rgb;
 	raw.convertTo(q, eight ? CV_8U : CV_16U, scale);
 	cv::demosaicing(q, rgb, bayerCode(layout, method));
+	if (const int shift = eight ? vngRowShift() : 0; shift != 0 && rgb.rows > std::abs(shift))
+	{
+		// Rows back in place; the ones it left uncovered repeat the border.
+		const int n = rgb.rows - std::abs(shift);
+		cv::Mat moved;
+		cv::copyMakeBorder(
+			rgb.rowRange(shift > 0 ? 0 : -shift, shift > 0 ? n : rgb.rows), moved,
+			shift > 0 ? shift : 0, shift > 0 ? 0 : -shift, 0, 0, cv::BORDER_REPLICATE);
+		rgb = moved;
+	}
 	cv::Mat out;
 	rgb.convertTo(out, CV_32FC3, 1 / scale);
 	return out;
