@@ -29,53 +29,22 @@ struct Print
 	double frame_px;
 };
 
-/** The sensor's view of \a print: per channel, blurred by a Gaussian of \a
- * sigma, integrated over each pixel, clipped at the sensor's top, then
- * sharpened by an unsharp mask (\a amount, radius 1 px) and encoded
- * through \a curve to 8 bits: the camera-pipeline's order. Returns the G
- * profile and -(R + B), \a n samples each. */
+/** The camera's view of \a print with the inner edge at \a x0
+ * (sim::cameraProfile()): the G profile and -(R + B), \a n samples each. */
 void cameraProfile(
 	const Print& print, double x0, double sigma, double amount, sim::Transfer curve, int n,
 	std::vector<int>& g, std::vector<int>& rb)
 {
-	const auto Phi = [&](double x) { return 0.5 * (1 + std::erf(x / (std::sqrt(2.0) * sigma))); };
-	std::array<std::vector<double>, 3> lin;
-	for (int c = 0; c < 3; ++c)
-	{
-		lin[c].assign(n, 0);
-		for (int i = 0; i < n; ++i)
-		{
-			double s = 0;
-			constexpr int kSub = 64;
-			for (int k = 0; k < kSub; ++k)
-			{
-				const double x = i - 0.5 + (k + 0.5) / kSub;
-				s += print.wall[c] +
-					 (print.black[c] - print.wall[c]) * Phi(x - (x0 - print.frame_px)) +
-					 (print.fill[c] - print.black[c]) * Phi(x - x0);
-			}
-			lin[c][i] = std::min(1.0, s / kSub);
-		}
-		if (amount > 0)
-		{
-			cv::Mat m(1, n, CV_64F, lin[c].data()), b;
-			cv::GaussianBlur(m, b, cv::Size(0, 0), 1.0, 0, cv::BORDER_REPLICATE);
-			const std::vector<double> base = lin[c];
-			for (int i = 0; i < n; ++i)
-				lin[c][i] = base[i] + amount * (base[i] - b.at<double>(0, i));
-		}
-	}
-	const auto encode = [&](double v)
-	{
-		return static_cast<int>(
-			std::lround(255 * sim::encodeTransfer(std::clamp(v, 0.0, 1.0), curve)));
-	};
+	sim::PrintProfile p;
+	p.edges = {x0 - print.frame_px, x0};
+	p.levels = {print.wall, print.black, print.fill};
+	const auto px = sim::cameraProfile(p, n, sigma, amount, curve);
 	g.resize(n);
 	rb.resize(n);
 	for (int i = 0; i < n; ++i)
 	{
-		g[i] = encode(lin[1][i]);
-		rb[i] = -(encode(lin[0][i]) + encode(lin[2][i]));
+		g[i] = px[i][1];
+		rb[i] = -(px[i][0] + px[i][2]);
 	}
 }
 

@@ -151,6 +151,41 @@ TEST(CameraPipeline, EveryDemosaicingKeepsTheImageInPlace)
 	}
 }
 
+// The 1-D camera profile: in linear light without sharpening each pixel is
+// the blurred print averaged over the pixel (here against a numeric
+// average), a level above full scale clips, and the curve encodes.
+TEST(CameraPipeline, CameraProfileIsThePixelAveragedBlurredPrint)
+{
+	PrintProfile print;
+	print.edges = {6.3, 11.8};
+	print.levels = {{0.6, 0.6, 0.6}, {0.02, 0.02, 0.02}, {0.1, 1.4, 0.2}};
+	const double sigma = 0.7;
+	const auto linear = cameraProfile(print, 20, sigma, 0, Transfer::Linear);
+	const auto srgb = cameraProfile(print, 20, sigma, 0, Transfer::SRGB);
+	for (int i = 0; i < 20; ++i)
+		for (int c = 0; c < 3; ++c)
+		{
+			double sum = 0;
+			constexpr int kSub = 2000;
+			for (int k = 0; k < kSub; ++k)
+			{
+				const double x = i - 0.5 + (k + 0.5) / kSub;
+				double v = print.levels[0][c];
+				for (size_t e = 0; e < 2; ++e)
+					v += (print.levels[e + 1][c] - print.levels[e][c]) * 0.5 *
+						 std::erfc(-(x - print.edges[e]) / (std::sqrt(2.0) * sigma));
+				sum += v;
+			}
+			const double expected = std::min(1.0, sum / kSub);
+			// Within the 8-bit rounding.
+			EXPECT_NEAR(linear[i][c], 255 * expected, 0.5 + 1e-6) << i << " " << c;
+			EXPECT_NEAR(srgb[i][c], 255 * encodeTransfer(expected, Transfer::SRGB), 0.5 + 1e-6)
+				<< i << " " << c;
+		}
+	EXPECT_EQ(linear[19][1], 255);	// G at 1.4 clips
+	EXPECT_THROW(cameraProfile(print, 0, sigma, 0, Transfer::Linear), std::invalid_argument);
+}
+
 TEST(CameraPipeline, DefocusKernelIsADiscSummingToOne)
 {
 	for (double r : {0.3, 0.8, 1.5, 3.0})

@@ -394,6 +394,48 @@ cv::Mat demosaicRaw(const cv::Mat& raw, BayerLayout layout, Demosaic method)
 	return out;
 }
 
+std::vector<std::array<int, 3>> cameraProfile(
+	const PrintProfile& print, int n, double sigma, double unsharp_amount, Transfer curve,
+	double gamma, double filmic_strength)
+{
+	if (print.levels.size() != print.edges.size() + 1 || n < 1 || !(sigma > 0))
+		throw std::invalid_argument(
+			"cameraProfile: levels must outnumber edges by one, n >= 1 and sigma > 0");
+	// The blurred print averaged over pixel i: each step's pixel-integrated
+	// normal CDF, sum over [i - 1/2, i + 1/2] of Phi((x - e) / sigma).
+	const auto integral = [&](double x)
+	{
+		// Integral of Phi(t / sigma) dt from -inf to x.
+		const double z = x / sigma;
+		return sigma * (z * 0.5 * std::erfc(-z / std::sqrt(2.0)) +
+						std::exp(-0.5 * z * z) / std::sqrt(2 * M_PI));
+	};
+	cv::Mat lin(1, n, CV_64FC3);
+	for (int i = 0; i < n; ++i)
+		for (int c = 0; c < 3; ++c)
+		{
+			double v = print.levels[0][c];
+			for (size_t k = 0; k < print.edges.size(); ++k)
+				v += (print.levels[k + 1][c] - print.levels[k][c]) *
+					 (integral(i + 0.5 - print.edges[k]) - integral(i - 0.5 - print.edges[k]));
+			lin.at<cv::Vec3d>(0, i)[c] = std::min(1.0, v);
+		}
+	if (unsharp_amount > 0)
+	{
+		cv::Mat blurred;
+		cv::GaussianBlur(lin, blurred, cv::Size(0, 0), 1.0, 0, cv::BORDER_REPLICATE);
+		lin += unsharp_amount * (lin - blurred);
+	}
+	std::vector<std::array<int, 3>> out(n);
+	for (int i = 0; i < n; ++i)
+		for (int c = 0; c < 3; ++c)
+			out[i][c] = static_cast<int>(std::lround(
+				255 * encodeTransfer(
+						  std::clamp(lin.at<cv::Vec3d>(0, i)[c], 0.0, 1.0), curve, gamma,
+						  filmic_strength)));
+	return out;
+}
+
 void applyTransfer(cv::Mat& img, Transfer t, double gamma, double filmic_strength)
 {
 	CV_Assert(img.depth() == CV_32F);

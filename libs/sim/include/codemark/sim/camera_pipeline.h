@@ -28,8 +28,10 @@
  */
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace codemark::sim
 {
@@ -114,6 +116,26 @@ cv::Mat mosaic(const cv::Mat& img, BayerLayout layout);
  * 0..255: quantised to 16 bits (8 bits for VNG, OpenCV's limit) as a
  * raw file is, then cv::demosaicing. */
 cv::Mat demosaicRaw(const cv::Mat& raw, BayerLayout layout, Demosaic method);
+
+/** A print across its edges in one dimension, in linear light: levels[0]
+ * (B, G, R) [0..1 of full scale, above 1 clips] up to edges[0] [px],
+ * levels[1] up to edges[1], and so on; levels has one more entry than
+ * edges. */
+struct PrintProfile
+{
+	std::vector<double> edges;
+	std::vector<std::array<double, 3>> levels;
+};
+
+/** Pixels 0..n-1 of \a print through the camera pipeline's stages that act
+ * on a profile across edges, in its order: a Gaussian blur of \a sigma
+ * [px] integrated over each pixel (exact, through the normal's CDF), the
+ * sensor's clip at full scale, an unsharp mask of radius 1 px and \a
+ * amount, the transfer curve \a curve, 8-bit rounding. For tests and
+ * benchmarks of edge locators against a known edge. B, G, R per pixel. */
+std::vector<std::array<int, 3>> cameraProfile(
+	const PrintProfile& print, int n, double sigma, double unsharp_amount, Transfer curve,
+	double gamma = 2.2, double filmic_strength = 0.25);
 
 /** Encodes a linear CV_32FC3 image in place (0..255 in and out, clamped). */
 void applyTransfer(cv::Mat& img, Transfer t, double gamma, double filmic_strength);
