@@ -806,26 +806,6 @@ TEST(Subpixel, PeakModeRemovesTheMarginsEdgeAfterIt)
 			}
 }
 
-// A dim fill (G 25) next to a bright, sharpened sheet (44) through a frame
-// 4 px wide: the outer edge's lobe is three times the inner edge's height,
-// beyond what the lobe model removes. Its iterations ran the peak a pixel
-// and a half onto the lobe's side (from 8.5 to 7.0); the edge as seen
-// stays. (Profiles of one side of a landmark at 4 m through the family
-// preset.)
-TEST(Subpixel, PeakModeKeepsTheEdgeUnderALobeSeveralTimesItsHeight)
-{
-	const std::vector<int> v{42, 40, 40, 42, 44, 27, 7,	 6,	 13, 18,
-							 25, 24, 26, 26, 27, 27, 27, 25, 25};
-	const int n = static_cast<int>(v.size());
-	const SubpixelParams p;
-	const auto seen = locateRisingEdge(v.data(), n, 6, 12, 5, p, EdgeMode::Peak);
-	const auto modelled = locateRisingEdge(v.data(), n, 6, 12, 5, p, EdgeMode::Peak, 3.91);
-	ASSERT_TRUE(seen && modelled);
-	// G crosses halfway between the frame (6-7) and the fill (25-26) at 8.6.
-	EXPECT_NEAR(*seen, 8.6, 0.3);
-	EXPECT_NEAR(*modelled, 8.6, 0.3);
-}
-
 TEST(Subpixel, NoEdgeOrFallingEdgeGivesNothing)
 {
 	const SubpixelParams p;

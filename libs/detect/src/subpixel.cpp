@@ -29,10 +29,6 @@ constexpr double kMinBlurFramePx = 2.5;
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
 constexpr double kLobeSeedVarPx2 = 0.7;
-/** The largest pull of a neighbouring edge's lobe on the peak that the
- * lobe model removes [px]: a frame 1.6 px wide pulls it by up to 0.56 px
- * at a blur of 1 px (Subpixel.PeakModeRemovesMostOfTheOuterEdgeOfAThinFrame). */
-constexpr double kMaxLobePullPx = 0.75;
 
 /** The peak of three samples a, b, c at -1, 0, 1 (b the largest): a
  * Gaussian through them (log-parabola), or a parabola where the logarithm
@@ -178,8 +174,6 @@ std::optional<double> locateRisingEdge(
 				lowest = std::min(lowest, d(k));
 			if (lowest < 0)
 			{
-				const double e_seen = e, var_seen = var;
-				const std::array<double, 3> fitted_seen = fitted;
 				double amp = dp;
 				for (int it = 0; it < 4 && var > 0; ++it)
 				{
@@ -199,17 +193,6 @@ std::optional<double> locateRisingEdge(
 					amp = b;
 					fitted = {a, b, c};
 					if (settled) break;
-				}
-				// A lobe several times the edge's height (a sharpened,
-				// bright sheet next to a dim fill) takes the iterations out
-				// of the model's domain: they run the peak onto the lobe's
-				// side by a pixel or more, where a frame's outer edge pulls
-				// it by half a pixel at most. The edge as seen stays.
-				if (std::abs(e - e_seen) > kMaxLobePullPx)
-				{
-					e = e_seen;
-					var = var_seen;
-					fitted = fitted_seen;
 				}
 			}
 		}
