@@ -28,13 +28,11 @@ constexpr double kMinMarginPx = 1.0;
 /** ... and the narrowest in units of the edge's blur sigma: the half width
  * at half maximum of its derivative, sqrt(2 ln 2). */
 const double kMarginBlurs = std::sqrt(2 * std::log(2.0));
-/** The smallest mean shift of a landmark's sides [px] for which the
+/** The smallest shift of every side of a landmark [px] for which the
  * midline replaces the single-edge lines: the frame read 0.2 px narrower
- * than the homography's width, beyond what a clip in linear light and the
- * peak locator's own scatter do on average; a transfer curve does more to
- * each side. The mean, not each side: one side's shift scatters by about
- * a tenth of a pixel (a bend of 0.25 px leaves one of four sides under
- * 0.1 px in a quarter of webcam frames). */
+ * than the homography's width on all four sides, beyond what a clip in
+ * linear light and the peak locator's own scatter do to one; a transfer
+ * curve does more to each. */
 constexpr double kMinShiftPx = 0.1;
 /** Profiles read a side at most: for the decision and the first square
  * (the second pass's frame widths), and for the final line. The midline's
@@ -272,16 +270,14 @@ void centreOnFrame(
 	double margin_ratio, const SubpixelParams& p)
 {
 	// The first pass decides on a few profiles a side (kDecisionProfiles):
-	// where the frame reads, on average over the sides, as wide as the
-	// homography says, within the midline's own scatter, or wider
-	// (printers' dot gain widens it), there is no bend to undo, and the
-	// single-edge models (exact in linear light, with their restoration of
-	// a clipped fill) stay. A transfer curve bends every side of the
-	// landmark alike.
+	// where one side's frame reads as wide as the homography says, within
+	// the midline's own scatter, or wider (printers' dot gain widens it),
+	// there is no bend to undo, and the single-edge models (exact in
+	// linear light, with their restoration of a clipped fill) stay. A
+	// transfer curve bends every side of the landmark alike.
 	std::array<std::optional<FrameSide>, 4> read;
 	RefinedQuad next = q;
 	int count = 0;
-	double shift_sum = 0;
 	for (int side = 0; side < 4; ++side)
 	{
 		read[side] = readFrameSide(
@@ -289,11 +285,11 @@ void centreOnFrame(
 		if (!read[side]) continue;
 		auto m = midlineOfSide(*read[side], q, cam, frame_ratio, p);
 		if (!m) continue;
-		shift_sum += m->shift_px;
+		if (m->shift_px < kMinShiftPx) return;
 		next.sides[side] = std::move(m->line);
 		++count;
 	}
-	if (count == 0 || shift_sum < kMinShiftPx * count || !cornersFromSides(next, cam)) return;
+	if (count == 0 || !cornersFromSides(next, cam)) return;
 	// The second pass reads each such side on more profiles between the
 	// first's, around the first pass's square, and places every reading's
 	// midline with that square's frame widths: the widths, not the edges,

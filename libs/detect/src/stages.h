@@ -499,8 +499,8 @@ std::optional<FrameMidline> frameMidlineSide(
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles);
 
 /** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
- * on average over the sides it reads (the frame reads narrower than the
- * homography's width: a transfer curve or a clip bent its edges), each side
+ * on every side it reads (the frame reads narrower than the homography's
+ * width all round: a transfer curve or a clip bent its edges), each side
  * goes to the frame's midline, twice (the second time with the frame's
  * widths from the first's square, on the same readings), and the corners
  * follow; otherwise \a q stays as it is. */
