@@ -681,14 +681,14 @@ std::optional<RefinedQuad> refineQuadrangle(
 				prof, *makeLocator(chooseLocator(s, p, models), min_rise, p, models));
 		};
 		std::vector<std::optional<double>> edges = locateAll(props);
+		const LocatorKind kind = chooseLocator(props, p, models).kind;
 		// Undecided (a side along the pixel grid, one rounding of R + B all
 		// along): a fill above the top moves G's edges outwards only (its
 		// clip cuts the bright half of their response), by up to a tenth of
 		// a pixel. So where G's edges lie inwards of R + B's (less G's own
 		// rounding) and within R + B's rounding of them, G errs less than
 		// R + B whatever the level, and exactly nothing at the top.
-		if (undecided[side] && !retry &&
-			chooseLocator(props, p, models).kind == LocatorKind::Channels)
+		if (undecided[side] && !retry && kind == LocatorKind::Channels)
 		{
 			const auto g_edges = locateAll(restored);
 			double sum = 0;
@@ -731,8 +731,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// A thin frame read in G by the peak: kept for its print model,
 		// once all four lines give the frame's width.
 		thin[side].reset();
-		if (models.thin_frame && !all_clipped &&
-			chooseLocator(props, p, models).kind == LocatorKind::Peak && !props.saturated)
+		if (models.thin_frame && !all_clipped && kind == LocatorKind::Peak && !props.saturated)
 			thin[side] = ThinSide{prof.g, edges, n, prof.inward, prof.across};
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
 		// levels' rounding is one for all its edges.
