@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds and runs the pose benchmarks (issue 4): the calibration of C_P
-# (codemark-bench-pose-calib, the values of
-# codemark::pipeline::detectorCalibratedPoseOptions) and the accuracy map
+# (codemark-bench-pose-calib, the data behind the shipped calibrations
+# share/codemark/calibration/*.ini) and the accuracy map
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,
 # general 6-DoF path and AprilTag 3), writing
 # apps/codemark-accuracy-map/results/ and copying the heat maps to
@@ -70,7 +70,7 @@ echo "== C_P calibration (realistic scenes, the shipped values: clipped and uncl
 "$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 60 --uniform-distance --averaged --noise-split 4
 echo "== C_P calibration (realistic scenes, clipped sides apart)"
 "$calib" --renders 1200 --seed 7 --realistic --max-bearing 0.35 --max-height 0.5 --max-distance 6 --max-angle 75 --uniform-distance
-echo "== C_P calibration (the accuracy map's flat background: its C_P, plainBackgroundPoseOptions)"
+echo "== C_P calibration (the accuracy map's flat background: its C_P, calibration plain)"
 "$calib" --renders 3000 --seed 7 --uniform-distance --noise-split 4
 echo "== accuracy map"
 "$map" --out apps/codemark-accuracy-map/results --renders 10

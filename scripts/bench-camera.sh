@@ -4,7 +4,8 @@
 # (scripts/povray-sets.sh) and on the project's renderer at the same poses,
 # each through the camera presets linear, webcam, phone and family; writes
 # docs/benchmarks/camera.md and docs/benchmarks/camera-frames.csv (one row
-# per frame).
+# per frame). With --calibration FILE|NAME (docs/calibration.md) other than
+# the default, C_P comes from it and the report is camera-<name>.md.
 #
 # The set is rendered by scripts/povray-sets.sh into SETS (default
 # $HOME/.cache/codemark/povray-sets); POV-Ray's renders are cached outside
@@ -13,7 +14,7 @@
 # a frame on one core.
 #
 # Usage: scripts/bench-camera.sh [--quick] [--presets linear,webcam,phone,family]
-#        [--frames-per-group N] [--build-dir DIR] [other options of
+#        [--frames-per-group N] [--build-dir DIR] [--calibration FILE|NAME] [other options of
 #        codemark-bench-camera]
 # --quick: 2 frames per group, report on stdout only.
 # Environment: BUILD_DIR (default build-bench), SETS.
@@ -24,14 +25,16 @@ presets="linear,webcam,phone,family"
 per_group=25
 sets="${SETS:-$HOME/.cache/codemark/povray-sets}"
 quick=0
+calibration=realistic
 args=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     --quick) quick=1; shift ;;
     --presets) presets="$2"; shift 2 ;;
     --frames-per-group) per_group="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
+    --calibration) calibration="$2"; args+=("$1" "$2"); shift 2 ;;
     *) args+=("$1"); shift ;;
   esac
 done
@@ -52,6 +55,9 @@ if [[ $quick -eq 1 ]]; then
   "${run[@]}"
 else
   mkdir -p docs/benchmarks
-  "${run[@]}" --out docs/benchmarks/camera.md --csv docs/benchmarks/camera-frames.csv
-  echo "bench-camera.sh: wrote docs/benchmarks/camera.md and docs/benchmarks/camera-frames.csv"
+  # The default calibration's report is camera.md; another's camera-<name>.md.
+  name=camera
+  if [[ "$calibration" != realistic ]]; then name="camera-$(basename "$calibration" .ini)"; fi
+  "${run[@]}" --out "docs/benchmarks/$name.md" --csv "docs/benchmarks/$name-frames.csv"
+  echo "bench-camera.sh: wrote docs/benchmarks/$name.md and docs/benchmarks/$name-frames.csv"
 fi

@@ -11,6 +11,7 @@
  */
 #include <codemark/detect/options.h>
 #include <codemark/landmark/camera.h>
+#include <codemark/pipeline/pipeline.h>
 #include <codemark/pose/measurement.h>
 #include <codemark/sim/render.h>
 
@@ -33,11 +34,10 @@ struct SurveyOptions
 	double noise_sigma = 2.0;  //!< renderer pixel noise [grey levels]
 	double blur_sigma_px = 0.8;	 //!< renderer blur [px]
 	/** Noise model of P for C_L, C_R (the method field is ignored: both paths
-	 * run). Default: codemark::pipeline::detectorCalibratedPoseOptions(),
-	 * the detector's calibrated, size-dependent C_P. */
-	pose::PoseOptions pose;
+	 * run): the tools' default calibration (pipeline::calibratedPoseOptions()). */
+	pose::PoseOptions pose = pipeline::calibratedPoseOptions();
 	/** A one-line description of \a pose's noise model for the summary. */
-	std::string noise_label = "calibrated (pipeline::detectorCalibratedPoseOptions)";
+	std::string noise_label = std::string("calibration ") + pipeline::kDefaultCalibration;
 	/** codemark's detector settings (--detector-config). */
 	detect::DetectorOptions detector;
 	bool apriltag = true;  //!< also run AprilTag 3 + the general path

@@ -10,6 +10,7 @@
 #include <codemark/pipeline/pipeline.h>
 #include <codemark/sim/render.h>
 
+#include "../common/calibration.h"
 #include "../common/povray_args.h"
 #include "../common/progress.h"
 #include "accuracy_map.h"
@@ -53,8 +54,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<double> sigma_arg(
 			"", "sigma-px",
 			"A constant sigma of each component of P for the predicted covariances [px] (the "
-			"spec's diagonal C_P). Default: the detector's calibrated, size-dependent C_P "
-			"(codemark::pipeline::detectorCalibratedPoseOptions).",
+			"spec's diagonal C_P). Default: the size-dependent C_P of --calibration.",
 			false, 0, "PX", cmd);
 		TCLAP::ValueArg<std::string> sigma_source_arg(
 			"", "sigma-source",
@@ -63,11 +63,12 @@ int main(int argc, char** argv)
 			false, "Fixed", "NAME", cmd);
 		TCLAP::ValueArg<std::string> calibration_arg(
 			"", "calibration",
-			"C_P model: plain (plainBackgroundPoseOptions, fitted on the plain background this "
-			"map renders by default), realistic (the shipped detectorCalibratedPoseOptions, "
-			"fitted on the textured, lit walls of --realistic) or scene (the one fitted on the "
-			"scene rendered). Default scene.",
-			false, "scene", "NAME", cmd);
+			"C_P model: a calibration file (docs/calibration.md), the name of a shipped one "
+			"(share/codemark/calibration/: plain, fitted on the plain background this map "
+			"renders by default; realistic, the tools' default, fitted on the textured, lit "
+			"walls of --realistic), or scene (the one fitted on the scene rendered). Default "
+			"scene.",
+			false, "scene", "FILE|NAME", cmd);
 		TCLAP::SwitchArg paper_arg(
 			"", "paper-closed-form",
 			"The closed-form column uses the paper's formulas alone, without the weighted "
@@ -121,18 +122,8 @@ int main(int argc, char** argv)
 		o.blur_sigma_px = blur_arg.getValue();
 		std::string calibration = calibration_arg.getValue();
 		if (calibration == "scene") calibration = realistic_arg.getValue() ? "realistic" : "plain";
-		if (calibration == "plain")
-		{
-			o.pose = codemark::pipeline::plainBackgroundPoseOptions();
-			o.noise_label =
-				"calibrated on a plain background (pipeline::plainBackgroundPoseOptions)";
-		}
-		else if (calibration == "realistic")
-			o.pose = codemark::pipeline::detectorCalibratedPoseOptions();
-		else
-			throw std::invalid_argument(
-				"--calibration: expected scene, plain or realistic, got '" +
-				calibration_arg.getValue() + "'");
+		o.pose = codemark::pipeline::calibratedPoseOptions(calibration);
+		o.noise_label = "calibration " + calibration;
 		if (sigma_arg.isSet())
 		{
 			o.pose = codemark::pose::PoseOptions();

@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "calibration.h"
 #include "errors.h"
 #include "progress.h"
 #include "rawlog_check.h"
@@ -46,8 +47,10 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> config(
 			"", "config",
 			"ini with [DETECTOR] and [pose] sections (share/codemark/detector.ini "
-			"keys; pose: method = ClosedForm|General6Dof, sigma_px)",
+			"keys; pose: method = ClosedForm|General6Dof, and noise-model keys overriding "
+			"--calibration's)",
 			false, "", "INI", cmd);
+		auto calibration = codemark::app::calibrationArg(cmd);
 		TCLAP::SwitchArg br(
 			"", "bearing-range", "also insert the CObservationBearingRange twin (<CAM>_BR)", cmd);
 		TCLAP::SwitchArg drop("", "drop-images", "leave the image observations out", cmd);
@@ -61,6 +64,7 @@ int main(int argc, char** argv)
 		o.drop_images = drop.getValue();
 		o.threads = threads.getValue();
 		if (threads.getValue() < 0) throw std::runtime_error("--threads must be >= 0");
+		o.pipeline.pose = codemark::pipeline::calibratedPoseOptions(calibration.getValue());
 		if (!camera.getValue().empty())
 			o.pipeline.camera_override = codemark::CameraModel::load(camera.getValue());
 		const std::string lm = landmark.getValue().empty() ? codemark::findShareFile("landmark.ini")

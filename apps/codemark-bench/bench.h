@@ -26,6 +26,11 @@ struct Dataset
 	std::string map;  //!< landmark map (spec section 3) or MRPT landmark file
 	std::string gt;	 //!< ground truth, either form of spec section 6
 	std::string camera;	 //!< optional camera file: replaces the rawlog's intrinsics
+	/** Optional calibration of C_P (a file or a shipped calibration's
+	 * name): images are measured with it and annotated sightings measured
+	 * again (filters::StepperOptions::remeasure_sightings); the method
+	 * ini's [pose] keys override it. Empty: the default calibration. */
+	std::string calibration;
 };
 
 /** The whole benchmark ini. */

@@ -1,5 +1,7 @@
 // codemark-bench: the benchmark ini (share/codemark/bench.ini documents it).
 #include <codemark/landmark/camera.h>
+#include <codemark/landmark/text.h>
+#include <codemark/pipeline/pipeline.h>
 #include <mrpt/config/CConfigFile.h>
 
 #include <algorithm>
@@ -88,7 +90,7 @@ BenchConfig loadBenchConfig(const std::string& path)
 	c.getAllSections(sections);
 	static const std::set<std::string> bench_keys{
 		"methods", "config_dir", "data_dir", "min_span_px", "rpe_interval_s"};
-	static const std::set<std::string> dataset_keys{"rawlog", "map", "gt", "camera"};
+	static const std::set<std::string> dataset_keys{"rawlog", "map", "gt", "camera", "calibration"};
 	for (const auto& s : sections)
 	{
 		if (s.empty()) continue;  // keys before any section
@@ -103,7 +105,7 @@ BenchConfig loadBenchConfig(const std::string& path)
 					path, s, k,
 					is_bench ? "unknown key (expected methods, config_dir, data_dir, "
 							   "min_span_px or rpe_interval_s)"
-							 : "unknown key (expected rawlog, map, gt or camera)");
+							 : "unknown key (expected rawlog, map, gt, camera or calibration)");
 	}
 
 	if (c.sectionExists("bench"))
@@ -168,6 +170,25 @@ BenchConfig loadBenchConfig(const std::string& path)
 		d.map = file("map", true);
 		d.gt = file("gt", true);
 		d.camera = file("camera", false);
+		// A calibration file (relative to data_dir) or a shipped one's name.
+		if (const std::string v = trim(c.read_string(s, "calibration", "")); !v.empty())
+		{
+			const fs::path p = fs::path(v).is_absolute() ? fs::path(v) : data_dir / v;
+			if (fs::is_regular_file(p))
+				d.calibration = p.lexically_normal().string();
+			else if (v.find('/') == std::string::npos && v.find(".ini") == std::string::npos)
+				d.calibration = v;
+			else
+				fail(path, s, "calibration", p.string() + ": no such file");
+			try
+			{
+				pipeline::calibratedPoseOptions(d.calibration);
+			}
+			catch (const std::exception& e)
+			{
+				fail(path, s, "calibration", oneLineMessage(e.what()));
+			}
+		}
 		cfg.datasets.push_back(d);
 	}
 	if (cfg.datasets.empty()) fail(path, "", "", "no [dataset:NAME] section");

@@ -178,6 +178,11 @@ JobResult runJob(
 		so.loadFromConfigFile(mcfg, "stepper");
 		pipeline::PipelineOptions po;
 		po.detector.loadFromConfigFile(mcfg, "detector");
+		if (!ds.calibration.empty())
+		{
+			po.pose = pipeline::calibratedPoseOptions(ds.calibration);
+			so.remeasure_sightings = true;
+		}
 		po.pose.loadFromConfigFile(mcfg, "pose");
 		if (!mrpt_map) po.map = map;
 		po.camera_override = camera;

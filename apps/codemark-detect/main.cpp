@@ -3,6 +3,7 @@
  * and videos, and prints one JSON object per image (landmark-spec.md
  * section 5). Parses the command line and calls codemark::detect::detect().
  */
+#include "calibration.h"
 #include <codemark/detect/colour.h>
 #include <codemark/detect/detector.h>
 #include <codemark/detect/json.h>
@@ -78,7 +79,7 @@ struct Runner
 	LandmarkGeometry geometry;
 	detect::DetectorOptions options;
 	/** Pose options: the pipeline's, calibrated for this detector. */
-	pose::PoseOptions pose = pipeline::detectorCalibratedPoseOptions();
+	pose::PoseOptions pose = pipeline::calibratedPoseOptions();
 	std::string draw_dir, debug_dir;
 	bool colour_report = false;
 	int failures = 0;
@@ -318,9 +319,10 @@ int main(int argc, char** argv)
 			"", "config",
 			"Detector parameters: ini file with a [DETECTOR] section (share/codemark/detector.ini "
 			"lists every parameter with its default and unit), and optionally a [pose] section "
-			"(method = ClosedForm|General6Dof, sigma_px, sigma_y_px). Default: the built-in "
-			"defaults.",
+			"(method = ClosedForm|General6Dof, and any key of the noise model, which overrides "
+			"--calibration's). Default: the built-in defaults.",
 			false, "", "detector.ini", cmd);
+		auto calibration_arg = app::calibrationArg(cmd);
 		TCLAP::ValueArg<std::string> draw_arg(
 			"", "draw",
 			"Folder (created when missing) that receives one overlay PNG per image: the "
@@ -373,6 +375,7 @@ int main(int argc, char** argv)
 				throw std::runtime_error(path + ": " + e.what());
 			}
 		}
+		r.pose = pipeline::calibratedPoseOptions(calibration_arg.getValue());
 		if (config_arg.isSet())
 		{
 			r.options = detect::DetectorOptions::load(config_arg.getValue());

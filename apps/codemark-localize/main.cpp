@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 
+#include "calibration.h"
 #include "errors.h"
 #include "live_view.h"
 #include "progress.h"
@@ -57,6 +58,18 @@ int main(int argc, char** argv)
 			false, "", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> out(
 			"o", "out", "output directory (created)", true, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> calibration(
+			"", "calibration",
+			"C_P's noise model: a calibration file (docs/calibration.md) or the name of a "
+			"shipped one (" +
+				codemark::app::shippedNames() +
+				"). Images detected on the fly are "
+				"measured with it, and the sightings of an annotated rawlog are measured again "
+				"from "
+				"their stored corners and camera (their stored C_L and C_R are used without it). "
+				"The config's [pose] keys override it. Default: " +
+				std::string(codemark::pipeline::kDefaultCalibration) + ".",
+			false, "", "FILE|NAME", cmd);
 		TCLAP::SwitchArg gui(
 			"", "gui",
 			"live 3D view while running (estimate, ground truth, landmarks, current pose with its "
@@ -78,6 +91,7 @@ int main(int argc, char** argv)
 		req.gt_file = gt.getValue();
 		req.gt_map_file = gt_map.getValue();
 		req.out_dir = out.getValue();
+		req.calibration = calibration.getValue();
 		// MRPT reads a corrupt gzip stream as a clean end of file: check first.
 		codemark::app::checkRawlogGzip(req.rawlog);
 		if (gui_every.getValue() < 1) throw std::invalid_argument("--gui-every must be >= 1");

@@ -4,6 +4,7 @@
  * command line and calls codemark::pose (uncertainty.h).
  */
 #include <codemark/pose/uncertainty.h>
+#include "calibration.h"
 
 #include <tclap/CmdLine.h>
 
@@ -50,6 +51,14 @@ int main(int argc, char** argv)
 			"1 px). Default: the library's default (" +
 				std::to_string(cp::kDefaultSigmaPx) + ").",
 			false, cp::kDefaultSigmaPx, "PX", cmd);
+		TCLAP::ValueArg<std::string> calibration_arg(
+			"", "calibration",
+			"Predict with the size-dependent C_P of a calibration (a file, docs/calibration.md, "
+			"or the name of a shipped one: " +
+				codemark::app::shippedNames() + "; the tools measure with " +
+				codemark::pipeline::kDefaultCalibration +
+				") in place of --sigma-px's constant one.",
+			false, "", "FILE|NAME", cmd);
 		TCLAP::ValueArg<double> scale_arg(
 			"", "scale",
 			"Landmark scale for --out and --table (1 = the A4 landmark, 160 mm reference square). "
@@ -105,6 +114,13 @@ int main(int argc, char** argv)
 										  : codemark::CameraModel::load(camera_arg.getValue());
 		const double sigma = sigma_arg.getValue();
 		if (!(sigma > 0)) throw std::invalid_argument("--sigma-px must be > 0");
+		if (sigma_arg.isSet() && calibration_arg.isSet())
+			throw std::invalid_argument("--sigma-px and --calibration exclude each other");
+		const std::string noise_label = "C_P of calibration " + calibration_arg.getValue();
+		const cp::PoseOptions noise =
+			calibration_arg.isSet()
+				? codemark::pipeline::calibratedPoseOptions(calibration_arg.getValue())
+				: cp::constantNoise(sigma);
 		if (!(scale_arg.getValue() > 0)) throw std::invalid_argument("--scale must be > 0");
 		bool did = false;
 
@@ -113,7 +129,7 @@ int main(int argc, char** argv)
 			const auto [acc_m, acc_deg] = parsePair(size_for_arg.getValue(), "--size-for");
 			if (!distance_arg.isSet()) throw std::invalid_argument("--size-for needs --distance");
 			const cp::SizeAdvice a = cp::sizeFor(
-				camera, sigma, acc_m, acc_deg * M_PI / 180, distance_arg.getValue(),
+				camera, noise, acc_m, acc_deg * M_PI / 180, distance_arg.getValue(),
 				angle_arg.getValue() * M_PI / 180, k_arg.getValue(), min_size_arg.getValue());
 			std::cout << cp::describeSizeAdvice(a, k_arg.getValue());
 			did = true;
@@ -124,15 +140,25 @@ int main(int argc, char** argv)
 			const double dmax = xmax_arg.isSet() ? xmax_arg.getValue() : 5.0;
 			std::vector<double> d;
 			for (double x = 0.5; x <= dmax + 1e-9; x += 0.5) d.push_back(x);
-			std::cout << cp::accuracyTable(
-				camera, scale_arg.getValue(), sigma, angle_arg.getValue() * M_PI / 180, d,
-				min_size_arg.getValue());
+			std::cout
+				<< (calibration_arg.isSet()
+						? cp::accuracyTable(
+							  camera, scale_arg.getValue(), noise, noise_label,
+							  angle_arg.getValue() * M_PI / 180, d, min_size_arg.getValue())
+						: cp::accuracyTable(
+							  camera, scale_arg.getValue(), sigma,
+							  angle_arg.getValue() * M_PI / 180, d, min_size_arg.getValue()));
 			did = true;
 		}
 		if (out_arg.isSet() || !did)
 		{
 			cp::FigureOptions fo;
 			fo.sigma_px = sigma;
+			if (calibration_arg.isSet())
+			{
+				fo.noise = noise;
+				fo.noise_label = noise_label;
+			}
 			fo.scale = scale_arg.getValue();
 			if (xmax_arg.isSet()) fo.x_max_m = xmax_arg.getValue();
 			fo.magnification = mag_arg.getValue();

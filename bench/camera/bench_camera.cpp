@@ -447,6 +447,11 @@ int main(int argc, char** argv)
 			"detector parameters: an ini file with a [DETECTOR] section (default: the shipped "
 			"defaults)",
 			false, "", "detector.ini", cmd);
+		TCLAP::ValueArg<std::string> calibrationArg(
+			"", "calibration",
+			"C_P's calibration: a file (docs/calibration.md) or a shipped calibration's name "
+			"(default: the tools' default)",
+			false, pipeline::kDefaultCalibration, "FILE|NAME", cmd);
 		TCLAP::ValueArg<std::string> missesArg(
 			"", "misses",
 			"folder (created when missing) that receives the image of every eligible frame "
@@ -481,6 +486,7 @@ int main(int argc, char** argv)
 		const CameraModel& camera = base.camera;
 		const auto set = loadSet(set_dir, base);
 		pipeline::PipelineOptions popt;
+		popt.pose = pipeline::calibratedPoseOptions(calibrationArg.getValue());
 		if (configArg.isSet()) popt.detector = detect::DetectorOptions::load(configArg.getValue());
 		if (missesArg.isSet()) fs::create_directories(missesArg.getValue());
 
@@ -571,8 +577,9 @@ int main(int argc, char** argv)
 				  "POV-Ray renders; source `own`: the project's renderer at the same poses with "
 				  "the same scene keys (dim 0.35x and bright 1.6x light as gains, graded light "
 				  "as a +-25% gradient across the image). Each preset is the camera pipeline of "
-				  "docs/camera-pipeline.md, applied to both. The detector and C_P are the "
-				  "shipped defaults.\n\n";
+				  "docs/camera-pipeline.md, applied to both. The detector is the shipped "
+				  "default; C_P comes from the calibration `"
+			   << calibrationArg.getValue() << "` (docs/calibration.md).\n\n";
 		std::ostringstream cam;
 		cam << camera.width() << " x " << camera.height() << " px, fx = " << camera.fx() << " px";
 		if (outArg.isSet())

@@ -1,23 +1,25 @@
 /** \file pose_calib.cpp
- * codemark-bench-pose-calib: the data behind the detector's calibrated C_P
- * (codemark::pipeline::detectorCalibratedPoseOptions()). Renders a level
+ * codemark-bench-pose-calib: fits the noise model of P for codemark's
+ * detector and writes it as a calibration file (--out; docs/calibration.md,
+ * the shipped ones in share/codemark/calibration/). Renders a level
  * camera at random poses in front of one landmark (the accuracy map's flat
  * background by default, --realistic for the simulated datasets' scene;
  * pixel noise 2, blur 0.8 px, the paper's camera), runs codemark's
  * detector, optionally writes one CSV row per detection (pose, apparent
  * size, errors of the four corners and of P against the renderer's exact
  * truth), fits the noise model of pose::PoseOptions::primaryCovariance() by
- * maximum likelihood and prints it with a per-distance table
- * (docs/benchmarks/pose.md).
+ * maximum likelihood and prints it with a per-distance table.
  */
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/primary.h>
+#include <codemark/pose/calibration.h>
 #include <codemark/pose/measurement.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/sim/dataset.h>
 #include <codemark/sim/povray.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
+#include <mrpt/system/datetime.h>
 #include <tclap/CmdLine.h>
 
 #include <Eigen/Dense>
@@ -194,11 +196,16 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg averaged_arg(
 			"", "averaged",
 			"Fit the power-law model with clipped and unclipped sides averaged "
-			"(clipped_side_sigma_px 0), the form of the shipped "
-			"pipeline::detectorCalibratedPoseOptions().",
+			"(clipped_side_sigma_px 0), the form of the shipped calibration 'realistic'; "
+			"without it --out writes the tabulated fit with the clipped sides apart.",
 			cmd, false);
 		TCLAP::ValueArg<std::string> detector_arg(
 			"", "detector-config", "Detector options ini (share/codemark/detector.ini's format).",
+			false, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> out_arg(
+			"", "out",
+			"Calibration file to write (docs/calibration.md): the power-law fit with "
+			"--averaged, else the tabulated one; the noise split's tables with --noise-split.",
 			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> csv_arg(
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
@@ -483,6 +490,23 @@ int main(int argc, char** argv)
 		std::printf(
 			"  corner_midpoint_ratio %.2f corner_tilt_ratio %.2f\n", std::sqrt(zm / samples.size()),
 			std::sqrt(zt / samples.size()));
+		// The calibration --out writes: the power-law fit (--averaged) or the
+		// tabulated one below.
+		pose::PoseOptions fitted;
+		fitted.sigma_px = fx.floor;
+		fitted.sigma_y_px = fy.floor;
+		fitted.growth_x_px = fx.growth;
+		fitted.growth_y_px = fy.growth;
+		fitted.size_exponent_x = fx.exponent;
+		fitted.size_exponent_y = fy.exponent;
+		fitted.size_reference_px = ref;
+		fitted.corr_x12 = rfx;
+		fitted.corr_growth_x12 = rgx;
+		fitted.corr_y12 = rfy;
+		fitted.corr_growth_y12 = rgy;
+		fitted.clipped_side_sigma_px = fx.clip;
+		fitted.corner_midpoint_ratio = std::sqrt(zm / samples.size());
+		fitted.corner_tilt_ratio = std::sqrt(zt / samples.size());
 		// The same tabulated against size (PoseOptions::sigma_x_table,
 		// sigma_y_table): the maximum-likelihood sigma of each size bin (at
 		// least 60 detections, at most 12 bins), with the clipped sides' term
@@ -616,6 +640,18 @@ int main(int argc, char** argv)
 					tt.emplace_back(bin.size_px, ratio);
 			}
 			std::printf("  corner_tilt_ratio_table = %s\n", pose::toString(tt).c_str());
+			if (!averaged_arg.getValue())
+			{
+				fitted.sigma_x_table = tx;
+				fitted.sigma_y_table = ty;
+				fitted.corr_x12 = fitted.corr_y12 = 0;	// unused with the tables
+				fitted.corr_growth_x12 = rx;
+				fitted.corr_growth_y12 = ry;
+				fitted.aligned_edge_ratio = k_aligned;
+				fitted.corner_midpoint_ratio = std::sqrt(z1.midpoint);
+				fitted.corner_tilt_ratio = std::sqrt(z1.tilt);
+				fitted.corner_tilt_ratio_table = tt;
+			}
 			// The one ratio where no bin gives one (exact renders: no tilt error).
 			const auto tiltRatio2 = [&](const Sample& sm)
 			{ return tt.empty() ? z1.tilt : std::pow(pose::interpolateSigma(tt, sm.side_px), 2); };
@@ -702,6 +738,9 @@ int main(int argc, char** argv)
 					return out;
 				};
 				const pose::SigmaTable nx = split(true, tx), ny = split(false, ty);
+				fitted.reference_noise_grey = ref_measured;
+				fitted.noise_sigma_x_table = nx;
+				fitted.noise_sigma_y_table = ny;
 				std::printf(
 					"noise split (%zu detections again at noise %.2f, %d missed; the detector "
 					"measured %.3f and %.3f):\n"
@@ -755,7 +794,10 @@ int main(int argc, char** argv)
 							const double mid = 0.5 * (lo + hi);
 							(tiltZ(mid) > 1 ? lo : hi) = mid;
 						}
-						std::printf("  corner_tilt_noise_ratio = %.2f\n", 0.5 * (lo + hi));
+						{
+							fitted.corner_tilt_noise_ratio = std::round(50 * (lo + hi)) / 100;
+							std::printf("  corner_tilt_noise_ratio = %.2f\n", 0.5 * (lo + hi));
+						}
 					}
 					else
 						std::printf(
@@ -799,6 +841,35 @@ int main(int argc, char** argv)
 			std::printf(
 				"  all of P: clipped_side_sigma_px %.3f clipped_side_correlation %.1f\n", best_s,
 				best_r);
+			if (!averaged_arg.getValue())
+			{
+				fitted.clipped_side_sigma_px = best_s;
+				fitted.clipped_side_correlation = best_r;
+			}
+			else
+				fitted.clipped_side_sigma_px = 0;  // averaged into the sigmas
+			if (!out_arg.getValue().empty())
+			{
+				std::string command = "codemark-bench-pose-calib";
+				for (int a = 1; a < argc; ++a) command += std::string(" ") + argv[a];
+				char data[400];
+				std::snprintf(
+					data, sizeof data,
+					"data: %s renderer, %s scene, camera preset %s, %d renders at %.1f-%.1f m, "
+					"view angles up to %.0f deg; %zu detections, %d missed",
+					renderer_arg.getValue().c_str(),
+					realistic_arg.getValue() ? "realistic (textured wall, light gradient)"
+											 : "plain background",
+					preset_arg.getValue().empty() ? "none" : preset_arg.getValue().c_str(),
+					n_arg.getValue(), dmin_arg.getValue(), dmax_arg.getValue(), amax_arg.getValue(),
+					samples.size(), missed);
+				pose::saveCalibration(
+					out_arg.getValue(), fitted,
+					{"codemark calibration: the noise model of P for codemark's detector",
+					 "made by: " + command, data,
+					 "date: " + mrpt::system::dateTimeToString(mrpt::Clock::now())});
+				std::printf("wrote %s\n", out_arg.getValue().c_str());
+			}
 		}
 		std::printf(
 			"%-9s %5s %7s | %7s %7s | %7s %7s %7s %7s | %6s %6s %6s\n", "band", "n", "side",

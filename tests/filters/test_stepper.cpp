@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../pose/common.h"
 #include "common.h"
 
 using namespace codemark;
@@ -393,5 +394,48 @@ TEST(Stepper, DropsObliqueSightings)
 			EXPECT_EQ(ids, std::vector<int>({1, 2}));
 			EXPECT_EQ(s.sightings_too_oblique, 0);
 		}
+	}
+}
+
+// A rawlog annotated with one calibration, stepped with another
+// (codemark-localize --calibration): each sighting is measured again from
+// its stored corners and camera under the pipeline's C_P; without
+// remeasure_sightings the stored covariances stay.
+TEST(Stepper, RemeasuresAnnotatedSightingsUnderThePipelinesCalibration)
+{
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	Detection d;
+	d.id = 7;
+	d.corners = codemark::test::projectCorners(codemark::test::cameraAt(2.5, 0.4), cam, g);
+	pose::PoseOptions recorded;
+	recorded.sigma_px = 0.02;
+	auto lm = landmarksAt(kT0);
+	lm->camera = cam.params();
+	lm->sightings.push_back(
+		CObservationCodedLandmarks::TSighting::From(d, pose::measure(d, cam, g, recorded)));
+	const std::string path = tempFile("remeasure.rawlog");
+	writeRawlog(path, {lm});
+
+	pipeline::PipelineOptions pipe;
+	pipe.pose = recorded;
+	pipe.pose.sigma_px = 0.2;  // 10x the recorded noise
+	const pose::Measurement expected = pose::measure(d, cam, g, pipe.pose);
+	for (const bool remeasure : {false, true})
+	{
+		StepperOptions o;
+		o.remeasure_sightings = remeasure;
+		RawlogStepper st(path, o, pipe);
+		RawlogStep s;
+		ASSERT_TRUE(st.next(s));
+		const auto c = s.observations.getObservationByClass<CObservationCodedLandmarks>();
+		ASSERT_TRUE(c);
+		ASSERT_EQ(c->sightings.size(), 1u);
+		const auto& t = c->sightings[0];
+		EXPECT_EQ(t.id, 7);
+		const Eigen::Matrix3d want = remeasure ? expected.C_L : lm->sightings[0].C_L;
+		EXPECT_LT((t.C_L - want).norm(), 1e-12 * want.norm()) << remeasure;
+		EXPECT_LT((t.L - expected.L).norm(), 1e-6);
+		if (remeasure) EXPECT_NEAR(t.C_P(0, 0), 0.04, 1e-12);
 	}
 }

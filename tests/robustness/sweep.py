@@ -149,6 +149,12 @@ def setup(bin_dir, d):
     write(os.path.join(d, "simul_nolm.ini"), "[map]\nmap_file = %s\n" % os.path.join(d, "map_nolm.txt"))
     write(os.path.join(d, "poses_nan.txt"), "1 0 0.6 0 0 0\n2 0 nan 0 0 0\n")
     write(os.path.join(d, "gt_badnum.txt"), "1700000000.0 1.0 1.0 zero\n")
+    # Calibration files (docs/calibration.md).
+    cal = open(os.path.join(SHARE, "calibration", "realistic.ini")).read()
+    write(os.path.join(d, "cal_badcorr.ini"), re.sub(r"\ncorr_y12 = .*\n", "\ncorr_y12 = 1.5\n", cal))
+    write(os.path.join(d, "cal_missing.ini"), re.sub(r"\ncorr_y12 = .*\n", "\n", cal))
+    write(os.path.join(d, "cal_unknown.ini"), cal + "sigma_pixels = 0.1\n")
+    write(os.path.join(d, "cal_nan.ini"), re.sub(r"\nsigma_px = .*\n", "\nsigma_px = nan\n", cal))
     open(os.path.join(d, "setup.done"), "w").close()
 
 
@@ -196,6 +202,13 @@ for f in ["does_not_exist.ini", "cam_badnum.ini", "cam_missing.yaml"]:
 
 for f in ["does_not_exist.ini", "cam_badnum.ini", "cam_missing.ini", "cam_badnum.yaml"]:
     case("codemark-uncertainty", "camera_" + f.replace(".", "_"), ["--camera", "{d}/" + f, "--table"], re.escape(f))
+CAL = [("does_not_exist.ini", "does_not_exist.ini"), ("cal_badcorr.ini", r"cal_badcorr.ini:\d+: corr_y12"),
+       ("cal_missing.ini", "cal_missing.ini.*corr_y12"), ("cal_unknown.ini", r"cal_unknown.ini:\d+: .*sigma_pixels"),
+       ("cal_nan.ini", r"cal_nan.ini:\d+: sigma_px"), ("no-such-name", "no-such-name")]
+for f, where in CAL:
+    n = "calibration_" + f.split(".")[0].replace("cal_", "").replace("-", "_")
+    case("codemark-uncertainty", n, ["--calibration", "{d}/" + f if "." in f else f, "--table"], where)
+    case("codemark-detect", n, ["--calibration", "{d}/" + f if "." in f else f, "{d}/img_grey.png"], where)
 case("codemark-uncertainty", "sigma_nan", ["--sigma-px", "nan", "--table"], "sigma")
 case("codemark-uncertainty", "size_for_bad", ["--size-for", "0.1,abc"], "size-for")
 
@@ -219,6 +232,8 @@ case("codemark-annotate", "camera_badnum", ANN + ["-i", "{d}/ds/dataset.rawlog",
      "cam_badnum.ini")
 case("codemark-annotate", "map_badnum", ANN + ["-i", "{d}/ds/dataset.rawlog", "--map", "{d}/map_badnum.txt"],
      "map_badnum.txt:3")
+case("codemark-annotate", "calibration_badcorr",
+     ANN + ["-i", "{d}/ds/dataset.rawlog", "--calibration", "{d}/cal_badcorr.ini"], r"cal_badcorr.ini:\d+: corr_y12")
 case("codemark-annotate", "landmark_badnum", ANN + ["-i", "{d}/ds/dataset.rawlog", "--landmark", "{d}/lm_badnum.ini"],
      "lm_badnum.ini")
 
@@ -232,6 +247,15 @@ for f, where in [("does_not_exist.txt", "does_not_exist.txt"), ("empty.txt", "em
 case("codemark-localize", "config_missing",
      ["-c", "{d}/does_not_exist.ini", "-q", "-o", "{o}", "-r", "{d}/good.rawlog", "-m", "{d}/map.txt"],
      "does_not_exist.ini")
+case("codemark-localize", "calibration_badcorr",
+     loc("{d}/good.rawlog", extra=["--calibration", "{d}/cal_badcorr.ini"]), r"cal_badcorr.ini:\d+: corr_y12")
+case("codemark-localize", "calibration_missing", loc("{d}/good.rawlog", extra=["--calibration", "{d}/cal_missing.ini"]),
+     "cal_missing.ini.*corr_y12")
+# An annotated rawlog measured again with another shipped calibration.
+case("codemark-localize", "calibration_plain", loc("{d}/good.rawlog", extra=["--calibration", "plain"]), "",
+     expect="clean")
+case("codemark-accuracy-map", "calibration_badcorr",
+     ["--out", "{o}", "--no-apriltag", "--calibration", "{d}/cal_badcorr.ini"], r"cal_badcorr.ini:\d+: corr_y12")
 case("codemark-localize", "gt_badnum", loc("{d}/good.rawlog", extra=["-g", "{d}/gt_badnum.txt"]), "gt_badnum.txt:1")
 
 # codemark-bench (if built): a missing and an empty datasets ini.

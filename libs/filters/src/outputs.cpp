@@ -441,6 +441,11 @@ LocalizeSummary runLocalization(
 	so.loadFromConfigFile(cfg, "stepper");
 	pipeline::PipelineOptions po;
 	po.detector.loadFromConfigFile(cfg, "detector");
+	if (!req.calibration.empty())
+	{
+		po.pose = pipeline::calibratedPoseOptions(req.calibration);
+		so.remeasure_sightings = true;
+	}
 	po.pose.loadFromConfigFile(cfg, "pose");
 	if (!req.map_file.empty() && !isMrptLandmarksFile(req.map_file)) po.map = map;
 

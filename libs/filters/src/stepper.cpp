@@ -61,6 +61,7 @@ void StepperOptions::loadFromConfigFile(
 		c.read_float(s, "thrunModel.additional_std_phi", motion.thrunModel.additional_std_phi);
 	MRPT_LOAD_CONFIG_VAR(detect_images, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(max_view_angle_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(remeasure_sightings, bool, c, s);
 	if (!(max_view_angle_deg > 0))
 		throw std::invalid_argument("[" + s + "] max_view_angle_deg must be > 0 [deg]");
 }
@@ -80,6 +81,7 @@ void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "gaussianModel.minStdPHI", motion.gaussianModel.minStdPHI, -1, -1);
 	c.write(s, "detect_images", detect_images, -1, -1);
 	c.write(s, "max_view_angle_deg", max_view_angle_deg, -1, -1);
+	c.write(s, "remeasure_sightings", remeasure_sightings, -1, -1);
 }
 
 CPose2D interpolatePose(double t0, const CPose2D& p0, double t1, const CPose2D& p1, double t)
@@ -415,11 +417,43 @@ struct RawlogStepper::Impl
 				}
 				++s.images_detected;
 			}
+			else if (const auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o);
+					 c && opt.remeasure_sightings)
+			{
+				try
+				{
+					s.observations.insert(remeasured(*c));
+				}
+				catch (const std::exception& e)
+				{
+					throw std::runtime_error(
+						where(f.entry) + " (" + c->sensorLabel + "): " + mrpt::exception_to_str(e));
+				}
+			}
 			else
 				s.observations.insert(o);
 		}
 		dropOblique(s);
 		ready.push_back(std::move(s));
+	}
+
+	// \a c with each sighting measured again from its corners, quality and
+	// camera under the pipeline's options (StepperOptions::remeasure_sightings).
+	CObservationCodedLandmarks::Ptr remeasured(const CObservationCodedLandmarks& c) const
+	{
+		auto copy = std::make_shared<CObservationCodedLandmarks>(c);
+		const CameraModel camera =
+			pipe.camera_override ? *pipe.camera_override : CameraModel(c.camera);
+		for (auto& t : copy->sightings)
+		{
+			Detection d;
+			d.id = t.id;
+			d.corners = t.corners;
+			d.quality = t.quality;
+			t = CObservationCodedLandmarks::TSighting::From(
+				d, pose::measure(d, camera, pipeline::geometryFor(t.id, pipe), pipe.pose));
+		}
+		return copy;
 	}
 
 	// Replaces coded observations that hold sightings beyond

@@ -413,13 +413,18 @@ CameraModel CameraModel::load(
 	return CameraModel(c);
 }
 
-std::string findShareFile(const std::string& relative)
+std::vector<std::string> shareSearchDirs()
 {
 	std::vector<std::string> dirs;
 	if (const char* env = std::getenv("CODEMARK_SHARE_DIR")) dirs.emplace_back(env);
 	dirs.emplace_back(CODEMARK_SOURCE_SHARE_DIR);
 	dirs.emplace_back(CODEMARK_INSTALL_SHARE_DIR);
-	for (const auto& d : dirs)
+	return dirs;
+}
+
+std::string findShareFile(const std::string& relative)
+{
+	for (const auto& d : shareSearchDirs())
 	{
 		const std::string p = d + "/" + relative;
 		if (std::ifstream(p).good()) return p;

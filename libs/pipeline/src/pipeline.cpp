@@ -1,13 +1,30 @@
 #include <codemark/pipeline/pipeline.h>
+#include <codemark/pose/calibration.h>
 #include <mrpt/img/CImage.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
+#include <mutex>
 #include <stdexcept>
 
 namespace codemark::pipeline
 {
+pose::PoseOptions calibratedPoseOptions(const std::string& path_or_name)
+{
+	pose::PoseOptions base;
+	base.second_order_pose_covariance = true;
+	if (path_or_name != kDefaultCalibration)
+		return pose::loadCalibration(pose::resolveCalibration(path_or_name), base);
+	// Every PipelineOptions starts from the default: read its file once.
+	static std::mutex m;
+	static std::optional<pose::PoseOptions> cached;
+	const std::lock_guard<std::mutex> lock(m);
+	if (!cached)
+		cached = pose::loadCalibration(pose::shippedCalibrationPath(kDefaultCalibration), base);
+	return *cached;
+}
+
 LandmarkGeometry geometryFor(int id, const PipelineOptions& o)
 {
 	if (o.map)

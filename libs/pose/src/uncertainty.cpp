@@ -26,9 +26,23 @@ std::string fmt(double v, int prec)
 }
 }  // namespace
 
+PoseOptions constantNoise(double sigma_px)
+{
+	PoseOptions o;
+	o.sigma_px = sigma_px;
+	return o;
+}
+
 SightingUncertainty predictUncertainty(
 	const CameraModel& camera, const LandmarkGeometry& g, double sigma_px, double d, double angle,
 	double bearing, double height)
+{
+	return predictUncertainty(camera, g, constantNoise(sigma_px), d, angle, bearing, height);
+}
+
+SightingUncertainty predictUncertainty(
+	const CameraModel& camera, const LandmarkGeometry& g, const PoseOptions& noise, double d,
+	double angle, double bearing, double height)
 {
 	using mrpt::poses::CPose3D;
 	SightingUncertainty out;
@@ -61,9 +75,7 @@ SightingUncertainty predictUncertainty(
 		const Eigen::Vector3d pc = toCamera(ref[i]);
 		corners[i] = camera.distortNormalized({pc.x() / pc.z(), pc.y() / pc.z()});
 	}
-	PoseOptions opt;
-	opt.sigma_px = sigma_px;
-	out.measurement = measure(corners, camera, g, opt);
+	out.measurement = measure(corners, camera, g, noise);
 	out.in_image = in_image;
 	const Measurement& m = out.measurement;
 	out.size_px = 2 * std::min(m.P[1], m.P[3]);
@@ -81,12 +93,20 @@ SizeAdvice sizeFor(
 	const CameraModel& camera, double sigma_px, double position_m, double heading_rad,
 	double distance_m, double angle, double k, double min_size_px)
 {
-	if (!(position_m > 0) || !(heading_rad > 0) || !(distance_m > 0) || !(k > 0) || !(sigma_px > 0))
-		throw std::invalid_argument(
-			"sizeFor: accuracies, distance, k_sigma and sigma_px must be > 0");
-	const auto at = [&](double s) {
-		return predictUncertainty(camera, LandmarkGeometry::scaled(s), sigma_px, distance_m, angle);
-	};
+	if (!(sigma_px > 0)) throw std::invalid_argument("sizeFor: sigma_px must be > 0");
+	return sizeFor(
+		camera, constantNoise(sigma_px), position_m, heading_rad, distance_m, angle, k,
+		min_size_px);
+}
+
+SizeAdvice sizeFor(
+	const CameraModel& camera, const PoseOptions& noise, double position_m, double heading_rad,
+	double distance_m, double angle, double k, double min_size_px)
+{
+	if (!(position_m > 0) || !(heading_rad > 0) || !(distance_m > 0) || !(k > 0))
+		throw std::invalid_argument("sizeFor: accuracies, distance and k_sigma must be > 0");
+	const auto at = [&](double s)
+	{ return predictUncertainty(camera, LandmarkGeometry::scaled(s), noise, distance_m, angle); };
 	const auto accurate = [&](const SightingUncertainty& u)
 	{ return k * u.sigma_position_m <= position_m && k * u.sigma_heading_rad <= heading_rad; };
 	const auto ok = [&](const SightingUncertainty& u)
@@ -163,16 +183,26 @@ std::string accuracyTable(
 	const CameraModel& camera, double scale, double sigma_px, double angle,
 	const std::vector<double>& distances, double min_size_px)
 {
+	return accuracyTable(
+		camera, scale, constantNoise(sigma_px), "sigma_px " + fmt(sigma_px, 3), angle, distances,
+		min_size_px);
+}
+
+std::string accuracyTable(
+	const CameraModel& camera, double scale, const PoseOptions& noise,
+	const std::string& noise_label, double angle, const std::vector<double>& distances,
+	double min_size_px)
+{
 	const LandmarkGeometry g = LandmarkGeometry::scaled(scale);
 	std::ostringstream s;
 	s << "# landmark scale " << fmt(scale, 3) << " (reference square "
 	  << fmt(g.inner_size_m * 1000, 1) << " mm), view angle " << fmt(angle * 180 / M_PI, 1)
-	  << " deg, sigma_px " << fmt(sigma_px, 3) << ", camera " << camera.width() << "x"
-	  << camera.height() << " fx " << fmt(camera.fx(), 1) << "; 1-sigma values\n";
+	  << " deg, " << noise_label << ", camera " << camera.width() << "x" << camera.height()
+	  << " fx " << fmt(camera.fx(), 1) << "; 1-sigma values\n";
 	s << "# dist_m  size_px  l2_mm  phi1_deg  phi2_deg  pos_mm  heading_deg  usable\n";
 	for (const double d : distances)
 	{
-		const SightingUncertainty u = predictUncertainty(camera, g, sigma_px, d, angle);
+		const SightingUncertainty u = predictUncertainty(camera, g, noise, d, angle);
 		s << std::setw(8) << fmt(d, 2);
 		if (u.measurement.L[0] <= 0)
 		{
@@ -198,6 +228,7 @@ FigureScales drawUncertaintyFigure(
 	if (!(o.step_m > 0) || !(o.x_max_m >= o.x_min_m) || !(o.pixels_per_m > 0) || !(o.scale > 0))
 		throw std::invalid_argument("drawUncertaintyFigure: invalid grid options");
 	const LandmarkGeometry g = LandmarkGeometry::scaled(o.scale);
+	const PoseOptions noise = o.noise ? *o.noise : constantNoise(o.sigma_px);
 
 	struct Cell
 	{
@@ -213,7 +244,7 @@ FigureScales drawUncertaintyFigure(
 		{
 			const double angle = std::atan2(Y, X);
 			if (std::abs(angle) > o.max_view_angle_deg * M_PI / 180 + 1e-9) continue;
-			Cell c{X, Y, predictUncertainty(camera, g, o.sigma_px, std::hypot(X, Y), angle), false};
+			Cell c{X, Y, predictUncertainty(camera, g, noise, std::hypot(X, Y), angle), false};
 			c.usable = c.u.in_image && c.u.size_px >= o.min_size_px;
 			if (c.usable)
 			{
@@ -339,10 +370,10 @@ FigureScales drawUncertaintyFigure(
 			fmt(o.min_size_px, 0) + " px or out of view",
 		1);
 	text(
-		"sigma_px " + fmt(o.sigma_px, 3) + " per component of P; camera " +
-			std::to_string(camera.width()) + "x" + std::to_string(camera.height()) + ", fx " +
-			fmt(camera.fx(), 1) + " px; landmark scale " + fmt(o.scale, 2) + " (reference square " +
-			fmt(g.inner_size_m * 1000, 0) + " mm)",
+		(o.noise ? o.noise_label : "sigma_px " + fmt(o.sigma_px, 3) + " per component of P") +
+			"; camera " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()) +
+			", fx " + fmt(camera.fx(), 1) + " px; landmark scale " + fmt(o.scale, 2) +
+			" (reference square " + fmt(g.inner_size_m * 1000, 0) + " mm)",
 		2);
 	text("labels on the axis: 1-sigma position (worst direction) and heading", 3);
 	text("1 m", 4);

@@ -31,6 +31,12 @@ struct LocalizeRequest
 	 * for summary.json's landmark_rmse_m; may be empty. */
 	std::string gt_map_file;
 	std::string out_dir;  //!< output folder (created)
+	/** C_P's calibration (a file or a shipped calibration's name,
+	 * pipeline::calibratedPoseOptions()); the config's [pose] keys override
+	 * it. Empty: the default calibration for images detected on the fly,
+	 * and annotated sightings keep their stored C_L and C_R; set: annotated
+	 * sightings are measured again with it (StepperOptions::remeasure_sightings). */
+	std::string calibration;
 };
 
 struct LocalizeSummary;

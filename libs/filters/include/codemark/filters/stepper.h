@@ -49,6 +49,12 @@ struct StepperOptions : public mrpt::config::CLoadableOptions
 	 * systematic error that C_L does not describe and that made the filters
 	 * overconfident. >= 90 keeps everything. */
 	double max_view_angle_deg = 60.0;
+	/** Measure the sightings of annotated rawlogs again (their stored
+	 * corners, quality and camera, the pipeline options' C_P, the map's
+	 * sizes) instead of using their stored C_L and C_R: a rawlog annotated
+	 * with one calibration, localized with another (codemark-localize
+	 * --calibration). ini key `remeasure_sightings`. */
+	bool remeasure_sightings = false;
 
 	void loadFromConfigFile(
 		const mrpt::config::CConfigFileBase& source, const std::string& section) override;

@@ -78,4 +78,7 @@ class CameraModel
  * install prefix. Empty when not found. */
 std::string findShareFile(const std::string& relative);
 
+/** The folders findShareFile() looks in, in its order. */
+std::vector<std::string> shareSearchDirs();
+
 }  // namespace codemark

@@ -57,12 +57,9 @@ std::string toString(PoseMethod m);
 PoseMethod poseMethodFromString(const std::string& name);
 
 /** Default standard deviation of each component of P [px] of the pose
- * library alone (the spec's constant diagonal C_P; the paper used 1 px): the
- * corner accuracy issue 4's targets assume. codemark's own detector comes
- * with a calibrated, size-dependent C_P instead
- * (codemark::pipeline::detectorCalibratedPoseOptions(), measured by
- * codemark-bench-pose-calib; docs/benchmarks/pose.md), which every tool that
- * runs the detector uses. */
+ * library alone (the spec's constant diagonal C_P): a placeholder for code
+ * that sets no noise model. The tools measure with a calibration file's
+ * size-dependent C_P instead (calibration.h, docs/calibration.md). */
 constexpr double kDefaultSigmaPx = 0.05;
 
 /** A standard deviation tabulated against an apparent size: (size [px],

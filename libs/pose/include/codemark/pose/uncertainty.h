@@ -10,6 +10,7 @@
 #include <codemark/landmark/geometry.h>
 #include <codemark/pose/measurement.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,16 @@ SightingUncertainty predictUncertainty(
 	const CameraModel& camera, const LandmarkGeometry& geometry, double sigma_px, double distance_m,
 	double view_angle_rad, double bearing_rad = 0, double height_m = 0);
 
+/** The same with C_P from \a noise's noise model (a calibration,
+ * calibration.h: size-dependent, correlated). */
+SightingUncertainty predictUncertainty(
+	const CameraModel& camera, const LandmarkGeometry& geometry, const PoseOptions& noise,
+	double distance_m, double view_angle_rad, double bearing_rad = 0, double height_m = 0);
+
+/** Pose options whose C_P is the spec's constant diagonal, \a sigma_px on
+ * each component of P [px]. */
+PoseOptions constantNoise(double sigma_px);
+
 /** The answer of sizeFor(). */
 struct SizeAdvice
 {
@@ -62,6 +73,11 @@ SizeAdvice sizeFor(
 	const CameraModel& camera, double sigma_px, double position_m, double heading_rad,
 	double distance_m, double view_angle_rad, double k_sigma = 2.0, double min_size_px = 30.0);
 
+/** sizeFor() with C_P from \a noise's noise model. */
+SizeAdvice sizeFor(
+	const CameraModel& camera, const PoseOptions& noise, double position_m, double heading_rad,
+	double distance_m, double view_angle_rad, double k_sigma = 2.0, double min_size_px = 30.0);
+
 /** A text report of \a advice: the scale, the printed sizes and the
  * predicted accuracy at that scale. */
 std::string describeSizeAdvice(const SizeAdvice& advice, double k_sigma);
@@ -75,6 +91,13 @@ std::string accuracyTable(
 	const CameraModel& camera, double scale, double sigma_px, double view_angle_rad,
 	const std::vector<double>& distances_m, double min_size_px = 30.0);
 
+/** accuracyTable() with C_P from \a noise's noise model, described in the
+ * header line as \a noise_label. */
+std::string accuracyTable(
+	const CameraModel& camera, double scale, const PoseOptions& noise,
+	const std::string& noise_label, double view_angle_rad, const std::vector<double>& distances_m,
+	double min_size_px = 30.0);
+
 /** Magnifications used by drawUncertaintyFigure(). */
 struct FigureScales
 {
@@ -86,6 +109,10 @@ struct FigureScales
 struct FigureOptions
 {
 	double sigma_px = kDefaultSigmaPx;	//!< noise of each component of P [px]
+	/** When set, C_P from this noise model (a calibration) in place of
+	 * sigma_px, described in the figure as noise_label. */
+	std::optional<PoseOptions> noise;
+	std::string noise_label;
 	double scale = 1.0;	 //!< landmark scale (1 = A4)
 	double x_min_m = 0.5, x_max_m = 3.0;  //!< robot distances along the normal X_L [m]
 	double y_max_m = 2.0;  //!< robots at |Y_L| <= y_max_m [m]
