@@ -52,7 +52,6 @@ struct Sample
 	Eigen::Matrix<double, 8, 1> e_corner;  // (u, v) errors TL TR BR BL [px]
 	Eigen::Vector4d e_P;
 	std::array<bool, 4> clipped{};	// DetectionQuality::fill_clipped (top, right, bottom, left)
-	std::array<double, 4> bend{};  // DetectionQuality::frame_bend_px
 	/** PoseOptions::aligned_edge_ratio's weight of the top and bottom edges:
 	 * 1 - the rows between their ends (true corners), 0 beyond one row. */
 	double aligned_weight = 0;
@@ -140,109 +139,6 @@ std::vector<SizeBin> sizeBins(const std::vector<Sample>& v, const Size& size, si
 	}
 	return bins;
 }
-/** The command line as one string (a calibration's provenance). */
-std::string commandLine(int argc, char** argv)
-{
-	std::string command = "codemark-bench-pose-calib";
-	for (int a = 1; a < argc; ++a) command += std::string(" ") + argv[a];
-	return command;
-}
-
-/** -2 log-likelihood of \a v's P errors under \a o's full C_P (the pose
- * library's: size, noise, clipped, aligned and bent sides), and the mean
- * of the squared Mahalanobis distances over 4 (1: consistent). */
-std::pair<double, double> likelihood(const std::vector<Sample>& v, const pose::PoseOptions& o)
-{
-	double nll = 0, z = 0;
-	for (const auto& sm : v)
-	{
-		const Eigen::Matrix4d C = o.primaryCovariance(sm.P_true, sm.image_noise) +
-								  o.clippedSidesCovariance(sm.clipped) +
-								  o.alignedEdgesCovariance(sm.P_true, sm.rows_top, sm.rows_bottom) +
-								  o.bentSidesCovariance(sm.bend);
-		const Eigen::LDLT<Eigen::Matrix4d> ldlt(C);
-		const double d2 = sm.e_P.dot(ldlt.solve(sm.e_P));
-		nll += d2 + ldlt.vectorD().array().log().sum();
-		z += d2 / 4;
-	}
-	return {nll, z / std::max<size_t>(1, v.size())};
-}
-
-/** --base: the base calibration's model kept, its frame-bend terms fitted
- * by maximum likelihood on \a samples (grid search), written to \a out. */
-void fitBend(
-	const std::vector<Sample>& samples, const std::string& base_name, const std::string& out,
-	int argc, char** argv)
-{
-	const std::string base_path = pose::resolveCalibration(base_name);
-	pose::PoseOptions o = pose::loadCalibration(base_path);
-	o.bend_sigma_ratio = o.bend_correlation = 0;
-	const auto [nll0, z0] = likelihood(samples, o);
-	double bend_sum = 0;
-	int bend_n = 0;
-	for (const auto& sm : samples)
-		for (const double b : sm.bend)
-			if (b != 0)
-			{
-				bend_sum += std::abs(b);
-				++bend_n;
-			}
-	std::printf(
-		"base %s: normalised variance of P %.3f; %d sides with a frame bend read, mean |bend| "
-		"%.3f px\n",
-		base_path.c_str(), z0, bend_n, bend_n ? bend_sum / bend_n : 0.0);
-	double best = nll0, best_k = 0, best_r = 0;
-	for (int i = 1; i <= 80; ++i)
-		for (int j = 0; j <= 9; ++j)
-		{
-			o.bend_sigma_ratio = 0.025 * i;
-			o.bend_correlation = 0.1 * j;
-			const double nll = likelihood(samples, o).first;
-			if (nll < best)
-			{
-				best = nll;
-				best_k = o.bend_sigma_ratio;
-				best_r = o.bend_correlation;
-			}
-		}
-	o.bend_sigma_ratio = best_k;
-	o.bend_correlation = best_r;
-	const double z1 = likelihood(samples, o).second;
-	std::printf(
-		"fitted: bend_sigma_ratio %.3f bend_correlation %.1f; normalised variance of P %.3f\n",
-		best_k, best_r, z1);
-	// The spread of the squared Mahalanobis distances (4 DoF: median 3.36,
-	// 95% 9.49, 99.9% 18.47 when consistent).
-	std::vector<double> d2;
-	for (const auto& sm : samples)
-	{
-		const Eigen::Matrix4d C = o.primaryCovariance(sm.P_true, sm.image_noise) +
-								  o.clippedSidesCovariance(sm.clipped) +
-								  o.alignedEdgesCovariance(sm.P_true, sm.rows_top, sm.rows_bottom) +
-								  o.bentSidesCovariance(sm.bend);
-		d2.push_back(sm.e_P.dot(C.ldlt().solve(sm.e_P)));
-	}
-	std::sort(d2.begin(), d2.end());
-	const auto q = [&](double f) { return d2[std::min(d2.size() - 1, size_t(f * d2.size()))]; };
-	std::printf(
-		"  squared distances: median %.2f, 95%% %.2f, 99.9%% %.2f (consistent: 3.36, 9.49, "
-		"18.47)\n",
-		q(0.5), q(0.95), q(0.999));
-	if (out.empty()) return;
-	std::vector<std::string> provenance = {
-		"codemark calibration: the noise model of P for codemark's detector",
-		"made by: " + commandLine(argc, argv),
-		"data: the base model of " + base_path + " with its frame-bend terms fitted on " +
-			std::to_string(samples.size()) + " detections (" + std::to_string(bend_n) +
-			" sides with a bend read)",
-		"date: " + mrpt::system::dateTimeToString(mrpt::Clock::now())};
-	// The base's own provenance follows, marked as such.
-	std::ifstream in(base_path);
-	for (std::string line; std::getline(in, line) && line.rfind('#', 0) == 0;)
-		provenance.push_back("base: " + line.substr(std::min<size_t>(2, line.size())));
-	pose::saveCalibration(out, o, provenance);
-	std::printf("wrote %s\n", out.c_str());
-}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -311,13 +207,6 @@ int main(int argc, char** argv)
 			"Calibration file to write (docs/calibration.md): the power-law fit with "
 			"--averaged, else the tabulated one; the noise split's tables with --noise-split.",
 			false, "", "FILE", cmd);
-		TCLAP::ValueArg<std::string> base_arg(
-			"", "base",
-			"Keep this calibration's model (a file or a shipped calibration's name) and fit only "
-			"its frame-bend terms (bend_sigma_ratio, bend_correlation: C_P's growth with the "
-			"frame bend the detector reads) on these renders; --out writes the base with them. "
-			"Renders through a camera preset (--preset family) give the bends to fit.",
-			false, "", "FILE|NAME", cmd);
 		TCLAP::ValueArg<std::string> csv_arg(
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
 		TCLAP::ValueArg<double> noise_split_arg(
@@ -405,7 +294,6 @@ int main(int argc, char** argv)
 						s.e_P =
 							primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
 						s.clipped = dl.detection.quality.fill_clipped;
-						s.bend = dl.detection.quality.frame_bend_px;
 						s.image_noise = dl.detection.quality.image_noise_grey;
 						const auto& tc = img.truth[0].corners_px;
 						s.P_true = img.truth[0].P;
@@ -428,23 +316,17 @@ int main(int argc, char** argv)
 			std::ofstream f(csv_arg.getValue());
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
 				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
-				 "clipped_left,bend_top,bend_right,bend_bottom,bend_left,image_noise\n";
+				 "clipped_left\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
 				for (int k = 0; k < 8; ++k) f << "," << s.e_corner[k];
 				for (int k = 0; k < 4; ++k) f << "," << s.e_P[k];
 				for (int k = 0; k < 4; ++k) f << "," << int(s.clipped[k]);
-				for (int k = 0; k < 4; ++k) f << "," << s.bend[k];
-				f << "," << s.image_noise << "\n";
+				f << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
-		if (base_arg.isSet())
-		{
-			fitBend(samples, base_arg.getValue(), out_arg.getValue(), argc, argv);
-			return 0;
-		}
 		// A fit of a handful would print numbers that mean nothing.
 		if (samples.size() < 20)
 			throw std::runtime_error(
@@ -968,7 +850,8 @@ int main(int argc, char** argv)
 				fitted.clipped_side_sigma_px = 0;  // averaged into the sigmas
 			if (!out_arg.getValue().empty())
 			{
-				const std::string command = commandLine(argc, argv);
+				std::string command = "codemark-bench-pose-calib";
+				for (int a = 1; a < argc; ++a) command += std::string(" ") + argv[a];
 				char data[400];
 				std::snprintf(
 					data, sizeof data,

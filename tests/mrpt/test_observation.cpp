@@ -81,7 +81,6 @@ void expectSame(const CObservationCodedLandmarks& a, const CObservationCodedLand
 		EXPECT_EQ(x.quality.corner_sigma_px, y.quality.corner_sigma_px);
 		EXPECT_EQ(x.quality.fill_clipped, y.quality.fill_clipped);
 		EXPECT_EQ(x.quality.image_noise_grey, y.quality.image_noise_grey);
-		EXPECT_EQ(x.quality.frame_bend_px, y.quality.frame_bend_px);
 		EXPECT_EQ(x.method, y.method);
 	}
 }
@@ -149,22 +148,6 @@ TEST(CodedLandmarksObs, ImageNoiseRoundTrip)
 	expectSame(o, *back);
 	// A negative noise is corrupt data, not a measurement.
 	o.sightings[1].quality.image_noise_grey = -1;
-	EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)));
-}
-
-TEST(CodedLandmarksObs, FrameBendRoundTrip)
-{
-	// Version 3's frame bends (the golden file, version 0, reads them as 0,
-	// not read).
-	auto o = makeFilled();
-	o.sightings[0].quality.frame_bend_px = {{0.125, -0.03, 0.2, 0}};
-	o.sightings[1].quality.frame_bend_px = {{0.5, 0.25, 0.375, 0.0625}};
-	const auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(
-		codemark::test::fromBytes(codemark::test::toBytes(o)));
-	ASSERT_TRUE(back);
-	expectSame(o, *back);
-	// A non-finite bend is corrupt data.
-	o.sightings[1].quality.frame_bend_px[2] = std::numeric_limits<double>::quiet_NaN();
 	EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)));
 }
 

@@ -124,7 +124,6 @@ DetectionResult detectWithModels(
 		}
 		qual.corner_sigma_px = std::sqrt(var_end / 4);
 		qual.fill_clipped = refined->fill_clipped;
-		qual.frame_bend_px = refined->frame_bend_px;
 		qual.image_noise_grey =
 			landmarkNoiseRms(bgr, refined->corners_raw, codeCellRatio(fill_ratio));
 		qual.code_margin = code->margin;

@@ -232,10 +232,9 @@ std::optional<FrameMidline> midlineOfSide(
 	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, f.along);
 	size_t at_inner = 0, at_outer = 0;
 	std::vector<Eigen::Vector2d> pts;
-	std::vector<double> shifts, missing;
+	std::vector<double> shifts;
 	pts.reserve(f.reads.size());
 	shifts.reserve(f.reads.size());
-	missing.reserve(f.reads.size());
 	for (const auto& r : f.reads)
 	{
 		const auto c_in = acrossAt(inner, f.along, r.s, at_inner),
@@ -244,7 +243,6 @@ std::optional<FrameMidline> midlineOfSide(
 		const double width = f.inward * (*c_in - *c_out);
 		const double shift = share_in * (width - (r.e_in - r.e_out));
 		shifts.push_back(shift);
-		missing.push_back(width - (r.e_in - r.e_out));
 		const double c = r.base + f.inward * (r.e_in + shift);
 		Eigen::Vector2d pt = f.along == 1 ? Eigen::Vector2d(c, r.s) : Eigen::Vector2d(r.s, c);
 		if (distorted) pt = cam.undistortPixel(pt);
@@ -254,9 +252,7 @@ std::optional<FrameMidline> midlineOfSide(
 	auto line = fitLine(std::move(pts), p);
 	if (!line) return std::nullopt;
 	std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
-	std::nth_element(missing.begin(), missing.begin() + missing.size() / 2, missing.end());
-	return FrameMidline{
-		std::move(*line), shifts[shifts.size() / 2], 0.5 * missing[missing.size() / 2]};
+	return FrameMidline{std::move(*line), shifts[shifts.size() / 2]};
 }
 
 std::optional<FrameMidline> frameMidlineSide(
@@ -279,12 +275,9 @@ void centreOnFrame(
 	// there is no bend to undo, and the single-edge models (exact in
 	// linear light, with their restoration of a clipped fill) stay. A
 	// transfer curve bends every side of the landmark alike.
-	// Every side's bend is read and kept (DetectionQuality::frame_bend_px)
-	// whether or not the sides move onto their midlines.
 	std::array<std::optional<FrameSide>, 4> read;
 	RefinedQuad next = q;
 	int count = 0;
-	bool bent = true;
 	for (int side = 0; side < 4; ++side)
 	{
 		read[side] = readFrameSide(
@@ -292,13 +285,11 @@ void centreOnFrame(
 		if (!read[side]) continue;
 		auto m = midlineOfSide(*read[side], q, cam, frame_ratio, p);
 		if (!m) continue;
-		q.frame_bend_px[side] = m->bend_px;
-		bent = bent && m->shift_px >= kMinShiftPx;
+		if (m->shift_px < kMinShiftPx) return;
 		next.sides[side] = std::move(m->line);
 		++count;
 	}
-	next.frame_bend_px = q.frame_bend_px;
-	if (!bent || count == 0 || !cornersFromSides(next, cam)) return;
+	if (count == 0 || !cornersFromSides(next, cam)) return;
 	// The second pass reads each such side on more profiles between the
 	// first's, around the first pass's square, and places every reading's
 	// midline with that square's frame widths: the widths, not the edges,
@@ -326,7 +317,6 @@ void centreOnFrame(
 		auto m = midlineOfSide(*read[side], first, cam, frame_ratio, p);
 		if (!m) continue;
 		next.sides[side] = std::move(m->line);
-		next.frame_bend_px[side] = m->bend_px;
 		++count;
 	}
 	if (count == 0 || !cornersFromSides(next, cam)) return;

@@ -426,9 +426,6 @@ struct RefinedQuad
 	std::array<LineFit, 4> sides;  //!< top, right, bottom, left, in undistorted px
 	/** Per side: its fill clipped throughout (DetectionQuality::fill_clipped). */
 	std::array<bool, 4> fill_clipped{{false, false, false, false}};
-	/** Per side: the frame's bend as centreOnFrame() read it
-	 * (DetectionQuality::frame_bend_px); 0 where it was not read. */
-	std::array<double, 4> frame_bend_px{{0, 0, 0, 0}};
 };
 
 /** Edge profiles along each side of \a coarse (one per row or column), the
@@ -457,9 +454,6 @@ struct FrameMidline
 {
 	LineFit line;
 	double shift_px = 0;
-	/** Half the frame's missing width, median over the readings
-	 * (DetectionQuality::frame_bend_px) [px]. */
-	double bend_px = 0;
 };
 
 /** One profile across a side's black frame (readFrameSide()). */

@@ -46,8 +46,8 @@ CObservationCodedLandmarks::TSighting CObservationCodedLandmarks::TSighting::Fro
 }
 
 // Version 1 adds DetectionQuality::fill_clipped (a bit per side), version 2
-// DetectionQuality::image_noise_grey, version 3 DetectionQuality::frame_bend_px.
-uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 3; }
+// DetectionQuality::image_noise_grey.
+uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 2; }
 
 void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -72,7 +72,6 @@ void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out)
 		for (int k = 0; k < 4; ++k) clipped |= s.quality.fill_clipped[k] ? (1u << k) : 0u;
 		out.WriteAs<uint8_t>(clipped);
 		out << s.quality.image_noise_grey;
-		for (const double b : s.quality.frame_bend_px) out << b;
 	}
 }
 
@@ -83,7 +82,6 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 		case 0:
 		case 1:
 		case 2:
-		case 3:
 		{
 			in >> timestamp >> sensorLabel >> cameraPose >> camera;
 			const auto n = in.ReadAs<uint32_t>();
@@ -132,14 +130,6 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 							"CObservationCodedLandmarks: corrupt data, image noise %g",
 							s.quality.image_noise_grey);
 				}
-				if (version >= 3)
-					for (double& b : s.quality.frame_bend_px)
-					{
-						in >> b;
-						if (!std::isfinite(b))
-							THROW_EXCEPTION_FMT(
-								"CObservationCodedLandmarks: corrupt data, frame bend %g", b);
-					}
 				// A detection never has a non-finite measurement; such a value
 				// would only poison a filter later, far from its cause.
 				bool finite = s.P.allFinite() && s.L.allFinite() && s.C_L.allFinite() &&

@@ -60,8 +60,6 @@ const Key kKeys[] = {
 	number("clipped_side_sigma_px", Kind::NonNegative, &PoseOptions::clipped_side_sigma_px),
 	number(
 		"clipped_side_correlation", Kind::UnitCorrelation, &PoseOptions::clipped_side_correlation),
-	number("bend_sigma_ratio", Kind::NonNegative, &PoseOptions::bend_sigma_ratio),
-	number("bend_correlation", Kind::UnitCorrelation, &PoseOptions::bend_correlation),
 	number("aligned_edge_ratio", Kind::NonNegative, &PoseOptions::aligned_edge_ratio),
 	number("corner_midpoint_ratio", Kind::Positive, &PoseOptions::corner_midpoint_ratio),
 	number("corner_tilt_ratio", Kind::Positive, &PoseOptions::corner_tilt_ratio),

@@ -132,10 +132,6 @@ void PoseOptions::validate() const
 				"pose options: the correlations corr_* must lie in (-1, 1)");
 	if (!(clipped_side_correlation >= 0) || !(clipped_side_correlation < 1))
 		throw std::invalid_argument("pose options: clipped_side_correlation must lie in [0, 1)");
-	if (!(bend_sigma_ratio >= 0) || !std::isfinite(bend_sigma_ratio))
-		throw std::invalid_argument("pose options: bend_sigma_ratio must be finite and >= 0");
-	if (!(bend_correlation >= 0) || !(bend_correlation < 1))
-		throw std::invalid_argument("pose options: bend_correlation must lie in [0, 1)");
 	if (!(aligned_edge_ratio >= 0) || !std::isfinite(aligned_edge_ratio))
 		throw std::invalid_argument("pose options: aligned_edge_ratio must be finite and >= 0");
 	if (!(clipped_side_sigma_px >= 0) || !std::isfinite(clipped_side_sigma_px))
@@ -166,27 +162,11 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	// MRPT's readers take "0.05px" as 0.05 and "abc" as 0: check the numbers first.
 	requireIniNumbers(
 		c, s,
-		{"sigma_px",
-		 "sigma_y_px",
-		 "growth_x_px",
-		 "growth_y_px",
-		 "size_exponent_x",
-		 "size_exponent_y",
-		 "size_reference_px",
-		 "corr_x12",
-		 "corr_y12",
-		 "corr_growth_x12",
-		 "corr_growth_y12",
-		 "clipped_side_sigma_px",
-		 "clipped_side_correlation",
-		 "bend_sigma_ratio",
-		 "bend_correlation",
-		 "aligned_edge_ratio",
-		 "corner_midpoint_ratio",
-		 "corner_tilt_ratio",
-		 "corner_tilt_noise_ratio",
-		 "min_sigma_px",
-		 "reference_noise_grey"});
+		{"sigma_px", "sigma_y_px", "growth_x_px", "growth_y_px", "size_exponent_x",
+		 "size_exponent_y", "size_reference_px", "corr_x12", "corr_y12", "corr_growth_x12",
+		 "corr_growth_y12", "clipped_side_sigma_px", "clipped_side_correlation",
+		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio",
+		 "corner_tilt_noise_ratio", "min_sigma_px", "reference_noise_grey"});
 	requireIniNumbers(c, s, {"lm_max_iterations"}, true);
 	requireIniBooleans(
 		c, s, {"second_order_pose_covariance", "refine_on_primary", "fold_ambiguity"});
@@ -212,8 +192,6 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	MRPT_LOAD_CONFIG_VAR(corr_growth_y12, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(clipped_side_sigma_px, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(clipped_side_correlation, double, c, s);
-	MRPT_LOAD_CONFIG_VAR(bend_sigma_ratio, double, c, s);
-	MRPT_LOAD_CONFIG_VAR(bend_correlation, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(aligned_edge_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corner_midpoint_ratio, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(corner_tilt_ratio, double, c, s);
@@ -277,12 +255,6 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(
 		s, "clipped_side_correlation", clipped_side_correlation, -1, -1,
 		"correlation of two clipped sides' outward shifts (0..1)");
-	c.write(
-		s, "bend_sigma_ratio", bend_sigma_ratio, -1, -1,
-		"std. dev. of a side's outward shift per px of its frame bend; 0: off");
-	c.write(
-		s, "bend_correlation", bend_correlation, -1, -1,
-		"correlation of two sides' bend-driven outward shifts (0..1)");
 	c.write(
 		s, "aligned_edge_ratio", aligned_edge_ratio, -1, -1,
 		"extra sigma of a top/bottom edge along a pixel row, over sigma(y_i); 0: off");
@@ -371,38 +343,22 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(
 	return C;
 }
 
-namespace
+Eigen::Matrix4d PoseOptions::clippedSidesCovariance(const std::array<bool, 4>& clipped) const
 {
-/** C_P of outward shifts of the sides (top, right, bottom, left) with
- * standard deviations \a sigma [px] and correlation \a corr between any two. */
-Eigen::Matrix4d sideShiftsCovariance(const std::array<double, 4>& sigma, double corr)
-{
-	// P's change per unit outward shift of each side: a top or bottom
-	// shift d lengthens both vertical edges by d, each half-length by d / 2.
+	// P's change per unit outward shift of each side (top, right, bottom,
+	// left): a top or bottom shift d lengthens both vertical edges by d,
+	// each half-length by d / 2.
 	Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
 	A(1, 0) = A(3, 0) = 0.5;  // top
 	A(2, 1) = 1;  // right: x2
 	A(1, 2) = A(3, 2) = 0.5;  // bottom
 	A(0, 3) = -1;  // left: x1
-	Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
+	const double v = clipped_side_sigma_px * clipped_side_sigma_px;
+	Eigen::Matrix4d S = Eigen::Matrix4d::Zero();  // the clipped sides' shifts
 	for (int a = 0; a < 4; ++a)
-		for (int b = 0; b < 4; ++b) S(a, b) = (a == b ? 1.0 : corr) * sigma[a] * sigma[b];
+		for (int b = 0; b < 4; ++b)
+			if (clipped[a] && clipped[b]) S(a, b) = a == b ? v : clipped_side_correlation * v;
 	return A * S * A.transpose();
-}
-}  // namespace
-
-Eigen::Matrix4d PoseOptions::clippedSidesCovariance(const std::array<bool, 4>& clipped) const
-{
-	std::array<double, 4> sigma{};
-	for (int k = 0; k < 4; ++k) sigma[k] = clipped[k] ? clipped_side_sigma_px : 0.0;
-	return sideShiftsCovariance(sigma, clipped_side_correlation);
-}
-
-Eigen::Matrix4d PoseOptions::bentSidesCovariance(const std::array<double, 4>& bend_px) const
-{
-	std::array<double, 4> sigma{};
-	for (int k = 0; k < 4; ++k) sigma[k] = bend_sigma_ratio * std::abs(bend_px[k]);
-	return sideShiftsCovariance(sigma, bend_correlation);
 }
 
 Eigen::Matrix4d PoseOptions::alignedEdgesCovariance(
@@ -424,16 +380,16 @@ namespace
 {
 Measurement measureWith(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
-	const LandmarkGeometry& geometry, const PoseOptions& options, const DetectionQuality& quality)
+	const LandmarkGeometry& geometry, const PoseOptions& options,
+	const std::array<bool, 4>& clipped, double image_noise_grey)
 {
 	options.validate();
 	Measurement m;
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	const Eigen::Matrix4d C_primary = options.primaryCovariance(m.P, quality.image_noise_grey);
-	m.C_P = C_primary + options.clippedSidesCovariance(quality.fill_clipped) +
-			options.bentSidesCovariance(quality.frame_bend_px);
+	const Eigen::Matrix4d C_primary = options.primaryCovariance(m.P, image_noise_grey);
+	m.C_P = C_primary + options.clippedSidesCovariance(clipped);
 	if (options.aligned_edge_ratio > 0)
 	{
 		// Rows between the ends of the top (TL, TR) and bottom (BL, BR) edges.
@@ -527,7 +483,7 @@ Measurement measureWith(
 	const double tilt_ratio = options.cornerTiltRatio(m.P[1] + m.P[3]);
 	// The tilts' own share of the noise's growth (corner_tilt_noise_ratio).
 	Eigen::Vector2d tilt_extra = Eigen::Vector2d::Zero();
-	if (options.corner_tilt_noise_ratio > 0 && quality.image_noise_grey > 0)
+	if (options.corner_tilt_noise_ratio > 0 && image_noise_grey > 0)
 	{
 		const Eigen::Matrix4d grown = C_primary - options.primaryCovariance(m.P, 0);
 		const double k2 = options.corner_tilt_noise_ratio * options.corner_tilt_noise_ratio -
@@ -577,7 +533,7 @@ Measurement measure(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options)
 {
-	return measureWith(corners, camera, geometry, options, DetectionQuality());
+	return measureWith(corners, camera, geometry, options, {{false, false, false, false}}, 0);
 }
 
 Measurement measure(
@@ -597,7 +553,9 @@ Measurement measure(
 		// The detector's sigma already follows its image's noise.
 		o.reference_noise_grey = 0;
 	}
-	return measureWith(detection.corners, camera, geometry, o, detection.quality);
+	return measureWith(
+		detection.corners, camera, geometry, o, detection.quality.fill_clipped,
+		detection.quality.image_noise_grey);
 }
 
 }  // namespace codemark::pose

@@ -41,15 +41,6 @@ struct DetectionQuality
 	 * than 8 such blocks). pose::PoseOptions::reference_noise_grey scales
 	 * the noise-driven part of C_P with it. */
 	double image_noise_grey = 0;
-	/** Per side (top, right, bottom, left): half the black frame's missing
-	 * width, the frame's width the square predicts minus the one read
-	 * across its two edges, median along the side [px]. A camera's response
-	 * curve, sharpening and blur move the frame's inner and outer edges in
-	 * opposite directions by about this much; the detector centres the side
-	 * on the frame's midline where every side reads a bend. 0 where the
-	 * frame was not read (quiet margin unresolved). Its magnitude scales
-	 * C_P's bend term (pose::PoseOptions::bend_sigma_ratio). */
-	std::array<double, 4> frame_bend_px{{0, 0, 0, 0}};
 };
 
 /** One detected landmark. */

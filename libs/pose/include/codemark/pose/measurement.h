@@ -179,23 +179,6 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** The part of C_P that clipped sides add (see clipped_side_sigma_px),
 	 * sides in the order top, right, bottom, left. */
 	Eigen::Matrix4d clippedSidesCovariance(const std::array<bool, 4>& clipped) const;
-	/** Standard deviation of a side's outward shift per pixel of its frame
-	 * bend (DetectionQuality::frame_bend_px) [-]. A camera's response,
-	 * sharpening and blur bend the black frame's two edges in opposite
-	 * directions; the detector reads the bend from the frame's width and
-	 * centres the side on the frame's midline, which cancels most of it.
-	 * What is left, and the whole bias of a side left on its single edge,
-	 * grows with the bend: this term lets C_P follow the camera the image
-	 * came from without being told. Applied by measure(const Detection&,
-	 * ...) only. 0: off. ini key `bend_sigma_ratio`. */
-	double bend_sigma_ratio = 0;
-	/** Correlation (0..1) of two sides' bend-driven shifts (one response
-	 * bends every side alike: the square looks larger or smaller as a
-	 * whole). ini key `bend_correlation`. */
-	double bend_correlation = 0;
-	/** The part of C_P that the sides' frame bends add (see
-	 * bend_sigma_ratio), \a bend_px per side top, right, bottom, left. */
-	Eigen::Matrix4d bentSidesCovariance(const std::array<double, 4>& bend_px) const;
 	/** A top or bottom edge that runs along a pixel row (its ends less than
 	 * a row apart in the image: a level camera at the landmark's height)
 	 * keeps one sub-pixel phase over its length, so the edge estimator's
