@@ -5,7 +5,7 @@
 # each through the camera presets linear, webcam, phone and family; writes
 # docs/benchmarks/camera.md and docs/benchmarks/camera-frames.csv (one row
 # per frame). With --calibration FILE|NAME (docs/calibration.md) other than
-# the default, C_P comes from it and the report is camera-<name>.md.
+# the tools' default (family), C_P comes from it and the report is camera-<name>.md.
 #
 # The set is rendered by scripts/povray-sets.sh into SETS (default
 # $HOME/.cache/codemark/povray-sets); POV-Ray's renders are cached outside
@@ -25,7 +25,7 @@ presets="linear,webcam,phone,family"
 per_group=25
 sets="${SETS:-$HOME/.cache/codemark/povray-sets}"
 quick=0
-calibration=realistic
+calibration=family
 args=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -57,7 +57,7 @@ else
   mkdir -p docs/benchmarks
   # The default calibration's report is camera.md; another's camera-<name>.md.
   name=camera
-  if [[ "$calibration" != realistic ]]; then name="camera-$(basename "$calibration" .ini)"; fi
+  if [[ "$calibration" != family ]]; then name="camera-$(basename "$calibration" .ini)"; fi
   "${run[@]}" --out "docs/benchmarks/$name.md" --csv "docs/benchmarks/$name-frames.csv"
   echo "bench-camera.sh: wrote docs/benchmarks/$name.md and docs/benchmarks/$name-frames.csv"
 fi

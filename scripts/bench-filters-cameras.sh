@@ -10,7 +10,10 @@
 # the first run ray-traces its frames (5-15 s each on one core), later runs
 # and other presets only re-run the camera pipeline.
 #
-# Usage: scripts/bench-filters-cameras.sh [--presets LIST] [--no-povray]
+# With --calibration FILE|NAME other than the tools' default (family), C_P comes from it
+# (docs/calibration.md) and the report is filters-cameras-<name>.md.
+#
+# Usage: scripts/bench-filters-cameras.sh [--presets LIST] [--no-povray] [--calibration FILE|NAME]
 # Environment: BUILD_DIR (default build-bench), SEEDS (default 3), SETS,
 # WORK (scratch folder for the own renderer's datasets).
 set -euo pipefail
@@ -22,11 +25,13 @@ WORK="${WORK:-/tmp/codemark_bench_filters_cameras}"
 DOC="$ROOT/docs/benchmarks/filters-cameras.md"
 presets="linear,webcam,phone,family"
 povray=1
+calibration=family
 while [[ $# -gt 0 ]]; do
 	case "$1" in
-		-h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+		-h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 		--presets) presets="$2"; shift 2 ;;
 		--no-povray) povray=0; shift ;;
+		--calibration) calibration="$2"; shift 2 ;;
 		*) echo "bench-filters-cameras.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
 	esac
 done
@@ -47,7 +52,10 @@ if [[ $povray -eq 1 ]]; then
 fi
 start=$SECONDS
 body=$("$BUILD_DIR/bench/filters_sim/filters_sim" --work "$WORK" --seeds "$SEEDS" --preset "$presets" \
-	--no-phi2-table "${datasets[@]}")
+	--no-phi2-table --calibration "$calibration" "${datasets[@]}")
+if [[ "$calibration" != family ]]; then
+	DOC="$ROOT/docs/benchmarks/filters-cameras-$(basename "$calibration" .ini).md"
+fi
 mkdir -p "$(dirname "$DOC")"
 {
 	echo "# Filter benchmarks per camera"
@@ -57,8 +65,9 @@ mkdir -p "$(dirname "$DOC")"
 	echo "Rows \"preset NAME\": the project's renderer, codemark-simul's default room"
 	echo "loop ($SEEDS seeds) through that camera preset (docs/camera-pipeline.md). Rows"
 	echo "\"POV-Ray room\": the POV-Ray room loop of scripts/povray-sets.sh (one run, two"
-	echo "laps, no odometry scale error) through that preset. The detector, C_P and"
-	echo "the filters' configs are the shipped ones."
+	echo "laps, no odometry scale error) through that preset. The detector and the"
+	echo "filters' configs are the shipped ones; C_P comes from the calibration"
+	echo "\`$calibration\` (docs/calibration.md)."
 	echo
 	echo "$body" | sed 's/^### /## /'
 } >"$DOC"

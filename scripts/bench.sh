@@ -34,7 +34,7 @@ noise_sigma   = 4.0
 blur_sigma_px = 1.2
 INI
 "$BIN/codemark-annotate/codemark-annotate" -q -i "$DATA/room-s3-noisy-obs/dataset.rawlog" \
-  -o "$DATA/room-s3-noisy-obs/annotated.rawlog"
+  -o "$DATA/room-s3-noisy-obs/annotated.rawlog" --calibration realistic
 
 echo "== codemark-bench: $OUT ($JOBS jobs)"
 status=0

@@ -20,8 +20,10 @@ start=$(date +%s)
 echo "== 1/4 simulate: $OUT/dataset"
 "$BIN/codemark-simul/codemark-simul" --config "$ROOT/share/codemark/simul.ini" --out "$OUT/dataset"
 echo "== 2/4 annotate: detect and measure every image"
+# The simulated images are linear light without a camera's pipeline: the
+# calibration fitted on such renders (docs/calibration.md).
 "$BIN/codemark-annotate/codemark-annotate" -i "$OUT/dataset/dataset.rawlog" \
-  -o "$OUT/dataset/annotated.rawlog"
+  -o "$OUT/dataset/annotated.rawlog" --calibration realistic
 for method in ekf pf; do
   echo "== 3/4 localize: $method"
   "$BIN/codemark-localize/codemark-localize" --config "$CFG/$method.ini" --method "$method" \

@@ -66,12 +66,14 @@ sim::DatasetSummary loadDataset(const fs::path& dir)
 }
 
 std::vector<RawlogStep> readSteps(
-	const std::string& rawlog, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map)
+	const std::string& rawlog, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
+	const std::string& calibration)
 {
 	StepperOptions so;
 	so.loadFromConfigFile(cfg, "stepper");
 	pipeline::PipelineOptions po;
 	po.detector.loadFromConfigFile(cfg, "detector");
+	po.pose = pipeline::calibratedPoseOptions(calibration);
 	po.pose.loadFromConfigFile(cfg, "pose");
 	po.map = map;
 	RawlogStepper st(rawlog, so, po);
@@ -299,6 +301,13 @@ int main(int argc, char** argv)
 			"NAME=DIR: also run every method on an existing dataset of codemark-simul (e.g. the "
 			"POV-Ray room loop of scripts/povray-sets.sh), one row named NAME; repeatable",
 			false, "NAME=DIR", cmd);
+		TCLAP::ValueArg<std::string> calibration(
+			"", "calibration",
+			"C_P's calibration for the images detected on the fly: a file (docs/calibration.md) "
+			"or a shipped calibration's name. Default realistic, the one fitted on "
+			"codemark-simul's "
+			"linear-light renders; --preset rows call for family (the tools' default).",
+			false, "realistic", "FILE|NAME", cmd);
 		TCLAP::SwitchArg no_phi2(
 			"", "no-phi2-table",
 			"skip the SLAM comparison with the BearingRange twin (codemark ekf-slam and MRPT's "
@@ -371,7 +380,8 @@ int main(int argc, char** argv)
 					}
 					mrpt::config::CConfigFile cfg(ini);
 					if (steps.empty())
-						steps = readSteps((dir / "dataset.rawlog").string(), cfg, ds.map);
+						steps = readSteps(
+							(dir / "dataset.rawlog").string(), cfg, ds.map, calibration.getValue());
 					auto& r = results[{nz.name, m}];
 					try
 					{
@@ -404,7 +414,9 @@ int main(int argc, char** argv)
 				if (!phi2_table || !fs::exists(slam_ini) || !fs::exists(kf_ini)) continue;
 				mrpt::config::CConfigFile slam_cfg(slam_ini), kf_cfg(kf_ini);
 				if (steps.empty())
-					steps = readSteps((dir / "dataset.rawlog").string(), slam_cfg, ds.map);
+					steps = readSteps(
+						(dir / "dataset.rawlog").string(), slam_cfg, ds.map,
+						calibration.getValue());
 				const auto twin = bearingRangeTwin(steps);
 				slam_rows[{nz.name, "codemark ekf-slam, coded sightings (L with phi2)"}].add(
 					runSteps(steps, "ekf-slam", slam_cfg, LandmarkMap(), ds, true), true);

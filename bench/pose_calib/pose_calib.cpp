@@ -52,11 +52,13 @@ struct Sample
 	Eigen::Matrix<double, 8, 1> e_corner;  // (u, v) errors TL TR BR BL [px]
 	Eigen::Vector4d e_P;
 	std::array<bool, 4> clipped{};	// DetectionQuality::fill_clipped (top, right, bottom, left)
+	std::array<double, 4> line_rms{};  // DetectionQuality::line_rms_px
 	/** PoseOptions::aligned_edge_ratio's weight of the top and bottom edges:
 	 * 1 - the rows between their ends (true corners), 0 beyond one row. */
 	double aligned_weight = 0;
 	double rows_top = 0, rows_bottom = 0;  // rows between the top and bottom edges' ends [px]
 	double image_noise = 0;	 // DetectionQuality::image_noise_grey (0: not measured)
+	int group = 0;	// --vary-scene: print (i % 3) + 3 * light
 	Eigen::Vector4d P_true = Eigen::Vector4d::Zero();
 	/** Clipped sides on x1, x2 (left, right: 0 or 1) and on y1, y2 (top and bottom: 0-2). */
 	int clippedOn(int component) const
@@ -187,6 +189,12 @@ int main(int argc, char** argv)
 			"Fraction of the renders with the camera exactly at the landmark's height (top and "
 			"bottom edges along pixel rows: PoseOptions::aligned_edge_ratio). Default 0.",
 			false, 0, "F", cmd);
+		TCLAP::SwitchArg vary_arg(
+			"", "vary-scene",
+			"Cycle each render's print and light through the per-camera benchmark's groups "
+			"(scripts/povray-sets.sh): fluorescent paper, an office inkjet's and a laser's green; "
+			"normal, dim (0.35x), bright (1.6x) and graded (+-25%) light.",
+			cmd, false);
 		TCLAP::SwitchArg uniform_distance_arg(
 			"", "uniform-distance",
 			"Draw distances uniformly (each distance as often) instead of uniformly in area (as "
@@ -276,7 +284,24 @@ int main(int argc, char** argv)
 				if (U(rng) < level_arg.getValue()) height = 0;
 				scene.world_T_camera =
 					sim::levelCameraLookingAt(lm, d, a * M_PI / 180, height, bearing);
-				const sim::Render img = renderer(scene, r, seed_arg.getValue() * 100003 + i);
+				sim::RenderOptions ri = r;
+				if (vary_arg.getValue())
+				{
+					// The prints' greens as linear reflectances x 255 (BGR), as
+					// scripts/povray-sets.sh draws them.
+					static const cv::Scalar kGreens[] = {
+						{0, 255, 0}, {20.4, 102.5, 5.4}, {26.1, 89.6, 11.5}};
+					ri.green_bgr = kGreens[i % 3];
+					const int light = (i / 3) % 4;
+					if (light == 1) ri.gain *= 0.35;
+					if (light == 2) ri.gain *= 1.6;
+					if (light == 3)
+					{
+						ri.gradient = 0.5;
+						ri.gradient_angle_rad = std::fmod(0.7 * i, 2 * M_PI);
+					}
+				}
+				const sim::Render img = renderer(scene, ri, seed_arg.getValue() * 100003 + i);
 				if (!img.truth[0].fully_visible) continue;
 				const auto res = detect::detect(img.image, scene.camera, g, dopt);
 				bool found = false;
@@ -294,7 +319,9 @@ int main(int argc, char** argv)
 						s.e_P =
 							primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
 						s.clipped = dl.detection.quality.fill_clipped;
+						s.line_rms = dl.detection.quality.line_rms_px;
 						s.image_noise = dl.detection.quality.image_noise_grey;
+						s.group = i % 12;
 						const auto& tc = img.truth[0].corners_px;
 						s.P_true = img.truth[0].P;
 						s.rows_top = tc[1].y() - tc[0].y();
@@ -316,14 +343,15 @@ int main(int argc, char** argv)
 			std::ofstream f(csv_arg.getValue());
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
 				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
-				 "clipped_left\n";
+				 "clipped_left,rms_top,rms_right,rms_bottom,rms_left,image_noise,group\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
 				for (int k = 0; k < 8; ++k) f << "," << s.e_corner[k];
 				for (int k = 0; k < 4; ++k) f << "," << s.e_P[k];
 				for (int k = 0; k < 4; ++k) f << "," << int(s.clipped[k]);
-				f << "\n";
+				for (int k = 0; k < 4; ++k) f << "," << s.line_rms[k];
+				f << "," << s.image_noise << "," << s.group << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
@@ -858,8 +886,11 @@ int main(int argc, char** argv)
 					"data: %s renderer, %s scene, camera preset %s, %d renders at %.1f-%.1f m, "
 					"view angles up to %.0f deg; %zu detections, %d missed",
 					renderer_arg.getValue().c_str(),
-					realistic_arg.getValue() ? "realistic (textured wall, light gradient)"
-											 : "plain background",
+					realistic_arg.getValue()
+						? (vary_arg.getValue()
+							   ? "realistic (textured wall) with prints and lights varied"
+							   : "realistic (textured wall, light gradient)")
+						: "plain background",
 					preset_arg.getValue().empty() ? "none" : preset_arg.getValue().c_str(),
 					n_arg.getValue(), dmin_arg.getValue(), dmax_arg.getValue(), amax_arg.getValue(),
 					samples.size(), missed);

@@ -1,6 +1,8 @@
 // The EKF on simulated datasets with rendered images (sim::writeDataset),
 // detected on the fly: a room loop with 5 Hz images and a 3% odometry scale
-// error, both rawlog formats, with the shipped share/codemark/config/ekf.ini.
+// error, both rawlog formats, with the shipped share/codemark/config/ekf.ini
+// and the calibration of the simulated datasets' renders (realistic: linear
+// light, no camera pipeline).
 #include <codemark/filters/outputs.h>
 #include <codemark/sim/dataset.h>
 #include <gtest/gtest.h>
@@ -33,6 +35,7 @@ LocalizeSummary runOn(
 	if (slam_no_map) req.gt_map_file = (dir / "map.txt").string();
 	req.gt_file = (dir / "gt_path.txt").string();
 	req.method = method;
+	req.calibration = "realistic";
 	return runLocalization(req);
 }
 

@@ -16,7 +16,8 @@ cd sim
 if [ "$MODE" = truth ]; then
 	"$TRUTH" dataset.rawlog gt_path.txt map.txt annotated.rawlog 3
 else
-	"$ANNOTATE" -i dataset.rawlog -o annotated.rawlog --map map.txt --drop-images -q
+	"$ANNOTATE" -i dataset.rawlog -o annotated.rawlog --map map.txt --drop-images -q \
+		--calibration realistic
 fi
 command -v pf-localization >/dev/null || { echo "pf-localization not installed (mrpt-apps)"; exit 1; }
 # pf-localization waits for a key after an error: stdin from /dev/null.

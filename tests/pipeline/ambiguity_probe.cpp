@@ -37,8 +37,8 @@ int main(int argc, char** argv)
 	ro.noise_sigma = 2;
 	ro.blur_sigma_px = 0.8;
 	const LandmarkGeometry g = lm.geometry();
-	pose::PoseOptions cf =
-		realistic ? pipeline::calibratedPoseOptions() : pipeline::calibratedPoseOptions("plain");
+	pose::PoseOptions cf = realistic ? pipeline::calibratedPoseOptions("realistic")
+									 : pipeline::calibratedPoseOptions("plain");
 	if (std::getenv("FOLD")) cf.fold_ambiguity = true;
 	pose::PoseOptions gen = cf;
 	gen.method = pose::PoseMethod::General6Dof;

@@ -1,5 +1,5 @@
 // Consistency of the pose covariance that the pipeline reports for codemark's
-// own detector (the shipped default calibration, calibrated by
+// own detector (the shipped calibration realistic, calibrated by
 // codemark-bench-pose-calib on other renders and seeds, see
 // docs/benchmarks/pose.md): over 320 noisy renders at random level-camera
 // poses at 0.5-4 m and view angles up to 60 deg (the calibration's range
@@ -60,7 +60,7 @@ const NeesResult& neesOnRenders()
 		const sim::RenderOptions ro = sim::DatasetOptions::realisticRender();
 		const LandmarkGeometry g = lm.geometry();
 		const detect::DetectorOptions dopt;
-		pose::PoseOptions cf = pipeline::calibratedPoseOptions(), gen = cf;
+		pose::PoseOptions cf = pipeline::calibratedPoseOptions("realistic"), gen = cf;
 		cf.method = pose::PoseMethod::ClosedForm;
 		gen.method = pose::PoseMethod::General6Dof;
 

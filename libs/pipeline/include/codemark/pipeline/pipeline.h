@@ -22,7 +22,7 @@ namespace codemark::pipeline
 {
 /** The shipped calibration of C_P that the tools measure with unless told
  * otherwise (share/codemark/calibration/<name>.ini; docs/calibration.md). */
-constexpr const char* kDefaultCalibration = "realistic";
+constexpr const char* kDefaultCalibration = "family";
 
 /** The pose options the tools measure with: the closed form refined on P,
  * C_R to second order in C_L, and the noise model of C_P from the
