@@ -226,6 +226,9 @@ struct Group
 		}
 		if (!r.detected) return;
 		++detected;
+		// The errors count where the detector's limits hold (the landmark
+		// spans >= 30 px, seen <= 60 deg off its normal).
+		if (!r.eligible) return;
 		corner.push_back(r.corner_err_px);
 		width.push_back(r.width_err_px);
 		height.push_back(r.height_err_px);
@@ -321,7 +324,8 @@ void writeReport(
 	os << header;
 	os << "## Overview\n\n"
 	   << "Detected: frames whose reference square spans >= 30 px and is seen <= 60 deg off "
-		  "its normal, found with their ID. Errors over the detected frames: range and phi2 RMS, "
+		  "its normal, found with their ID. Errors and NEES over those frames detected: range and "
+		  "phi2 RMS, "
 		  "position RMS of the camera in the landmark frame; NEES: mean of C_R's normalised "
 		  "squared error (3 DoF) with the 95% chi-square band of independent frames.\n\n"
 	   << "| source | preset | detected | wrong IDs | corner err [px] | size err w / h [px] | "
