@@ -65,7 +65,9 @@ if [[ $TIDY == 1 ]]; then
     args+=(-fix -format -style file -clang-apply-replacements-binary "$APPLY")
   fi
   start=$(date +%s)
-  "$RUN_TIDY" "${args[@]}" "$regex" >"$log" 2>&1 || true
+  # run-clang-tidy colours its lines (escape codes before the path): strip them,
+  # or the findings below would never be counted.
+  "$RUN_TIDY" "${args[@]}" "$regex" 2>&1 | sed -E 's/\x1b\[[0-9;]*m//g' >"$log" || true
   n=$(grep -cE '^/.*: (warning|error): .*\[[a-z]' "$log" || true)
   echo "lint: clang-tidy: $n findings over $(grep -c '"file"' "$BUILD/compile_commands.json") TUs in the database, $(( $(date +%s) - start )) s"
   if [[ $n -gt 0 ]]; then

@@ -24,7 +24,7 @@ SideProfiles readSideProfiles(
 	const int W = bgr.cols, H = bgr.rows;
 	// Side k runs from corner k to corner k+1 (top: TL-TR, right: TR-BR,
 	// bottom: BR-BL, left: BL-TL).
-	const Eigen::Vector2d a = coarse[side], b = coarse[(side + 1) % 4];
+	const Eigen::Vector2d &a = coarse[side], &b = coarse[(side + 1) % 4];
 	const Eigen::Vector2d ab = b - a;
 	// Scan rows for a mostly vertical side, columns otherwise; the profile
 	// runs across the side along the other axis.

@@ -97,7 +97,7 @@ std::optional<FrameSide> readFrameSide(
 	const Eigen::Vector2d centre =
 		0.25 * (q.corners_raw[0] + q.corners_raw[1] + q.corners_raw[2] + q.corners_raw[3]);
 	const int inward = out.inward = centre(across) > 0.5 * (a(across) + b(across)) ? 1 : -1;
-	const Eigen::Vector2d f0 = kFaceCorners[side], f1 = kFaceCorners[(side + 1) % 4];
+	const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
 	const auto inner = sidePolyline(map, f0, f1, 0, along);
 	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, along);
 	const auto sheet = sidePolyline(map, f0, f1, 2 * (frame_ratio + margin_ratio), along);
@@ -227,7 +227,7 @@ std::optional<FrameMidline> midlineOfSide(
 	// The frame's width at each reading from q's homography.
 	const bool distorted = cam.hasDistortion();
 	const FaceMap map{faceToImage(q.corners_ideal), cam, distorted};
-	const Eigen::Vector2d f0 = kFaceCorners[f.side], f1 = kFaceCorners[(f.side + 1) % 4];
+	const Eigen::Vector2d &f0 = kFaceCorners[f.side], &f1 = kFaceCorners[(f.side + 1) % 4];
 	const auto inner = sidePolyline(map, f0, f1, 0, f.along);
 	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, f.along);
 	size_t at_inner = 0, at_outer = 0;

@@ -8,6 +8,9 @@
 
 namespace codemark::detect
 {
+// Defined once per including TU, each under its own name, and called from
+// the other: not inline.
+// NOLINTNEXTLINE(misc-definitions-in-headers)
 int CODEMARK_STEP2_KERNEL(const Step2Rows& rows, const FillPredicate& pred)
 {
 #if CV_SIMD

@@ -574,7 +574,7 @@ void applyThinFrameModel(
 		{
 			if (!thin[side] || done[side]) continue;
 			const ThinSide& t = *thin[side];
-			const Eigen::Vector2d f0 = kFaceCorners[side], f1 = kFaceCorners[(side + 1) % 4];
+			const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
 			const Eigen::Vector2d in = 0.5 * (f0 + f1), outer = in + frame_ratio * (f0 + f1);
 			const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
 			// Under 2 px the frame never reaches its black: the model cannot

@@ -119,7 +119,7 @@ void symmetriseAndCheckCovariance(
 	}
 	P = (0.5 * (P + P.transpose())).eval();	 // eval: P.transpose() aliases P
 	Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(P);
-	const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+	const Eigen::Vector3d& ev = es.eigenvalues();  // ascending
 	if (ev[0] < -tolerance * std::max(1.0, ev[2]))
 	{
 		std::ostringstream os;

@@ -142,8 +142,7 @@ Eigen::Vector3d slamObservation(
 	const double sx = robot[0] + ox, sy = robot[1] + oy, syaw = robot[2] + sensor_on_robot.phi();
 	const double dx = landmark[0] - sx, dy = landmark[1] - sy;
 	const double r2 = dx * dx + dy * dy, r = std::sqrt(r2);
-	const Eigen::Vector3d h(
-		r, wrapToPi(std::atan2(dy, dx) - syaw), wrapToPi(syaw - landmark[2] - kPi));
+	Eigen::Vector3d h(r, wrapToPi(std::atan2(dy, dx) - syaw), wrapToPi(syaw - landmark[2] - kPi));
 	if (Hx)
 	{
 		// d(sx, sy)/d(yaw) = (-oy, ox).
@@ -170,7 +169,7 @@ Eigen::Vector3d slamInverseObservation(
 	const double syaw = robot[2] + sensor_on_robot.phi();
 	const double beta = syaw + z[1];
 	const double cb = std::cos(beta), sb = std::sin(beta);
-	const Eigen::Vector3d l(
+	Eigen::Vector3d l(
 		robot[0] + ox + z[0] * cb, robot[1] + oy + z[0] * sb, wrapToPi(syaw - z[2] - kPi));
 	if (Jx)
 	{

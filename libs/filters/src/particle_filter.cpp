@@ -218,7 +218,7 @@ StepStats ParticleFilterLocalizer::step(
 		}
 	}
 
-	m_pf.executeOn(m_pdf, &actions, sf.size() ? &sf : nullptr, &m_stats);
+	m_pf.executeOn(m_pdf, &actions, !sf.empty() ? &sf : nullptr, &m_stats);
 
 	// Does the best particle explain the frame's coded sightings?
 	auto gatedOut = [&](const mrpt::math::TPose2D& pose)

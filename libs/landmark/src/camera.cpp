@@ -426,7 +426,7 @@ std::string findShareFile(const std::string& relative)
 {
 	for (const auto& d : shareSearchDirs())
 	{
-		const std::string p = d + "/" + relative;
+		std::string p = d + "/" + relative;
 		if (std::ifstream(p).good()) return p;
 	}
 	return {};
@@ -473,7 +473,7 @@ std::optional<Eigen::Vector2d> CameraModel::project(const Eigen::Vector3d& p) co
 
 Eigen::Vector2d CameraModel::undistortToNormalized(const Eigen::Vector2d& raw) const
 {
-	const Eigen::Vector2d xd((raw.x() - cx()) / fx(), (raw.y() - cy()) / fy());
+	Eigen::Vector2d xd((raw.x() - cx()) / fx(), (raw.y() - cy()) / fy());
 	if (!hasDistortion()) return xd;
 	// Fixed-point iteration followed by Gauss-Newton polishing on the forward
 	// model: OpenCV's undistortPoints stops at a fixed iteration count, which

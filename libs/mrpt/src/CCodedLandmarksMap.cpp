@@ -174,7 +174,7 @@ void CCodedLandmarksMap::rebuildIndex()
 		m_cache.push_back({lm.x_m, lm.y_m, lm.z_m, std::cos(lm.yaw_rad), std::sin(lm.yaw_rad)});
 		if (lm.id >= 0 && lm.id < kMaxIndexedId) max_id = std::max(max_id, lm.id);
 	}
-	m_index.assign(static_cast<size_t>(max_id + 1), -1);
+	m_index.assign(static_cast<size_t>(max_id) + 1, -1);
 	for (size_t i = 0; i < m_map.landmarks.size(); ++i)
 	{
 		const int id = m_map.landmarks[i].id;

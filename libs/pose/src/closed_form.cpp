@@ -29,7 +29,7 @@ Eigen::Vector3d landmarkFromPrimary(
 	const double k = 0.5 * h * (1.0 / y1 + 1.0 / y2);  // = h (y1 + y2) / (2 y1 y2)
 	const double N = lambda * (y2 - y1);
 	const double D = x2 * y1 - x1 * y2;
-	const Eigen::Vector3d L(k * r, -std::atan2(xm, lambda), std::atan2(N, D));
+	Eigen::Vector3d L(k * r, -std::atan2(xm, lambda), std::atan2(N, D));
 
 	if (J_P)
 	{
@@ -193,7 +193,7 @@ mrpt::poses::CPose2D robotPoseInWorld(
 	using mrpt::poses::CPose2D;
 	const CPose2D world_T_camera = world_T_landmark + CPose2D(c[0], c[1], c[2]);
 	const CPose2D camera_T_robot = CPose2D() - robot_T_camera;	// inverse
-	const CPose2D world_T_robot = world_T_camera + camera_T_robot;
+	CPose2D world_T_robot = world_T_camera + camera_T_robot;
 	if (C_world || J_out)
 	{
 		// d(a (+) b)/db = rot(a.phi) (+ 1 for the angle);
