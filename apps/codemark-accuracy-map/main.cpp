@@ -65,8 +65,9 @@ int main(int argc, char** argv)
 			"", "calibration",
 			"C_P model: a calibration file (docs/calibration.md), the name of a shipped one "
 			"(share/codemark/calibration/: plain, fitted on the plain background this map "
-			"renders by default; realistic, the tools' default, fitted on the textured, lit "
-			"walls of --realistic), or scene (the one fitted on the scene rendered). Default "
+			"renders by default; realistic, fitted on the textured, lit walls of --realistic; "
+			"family, the tools' default, fitted through the camera presets), or scene (the one "
+			"fitted on the scene rendered). Default "
 			"scene.",
 			false, "scene", "FILE|NAME", cmd);
 		TCLAP::SwitchArg paper_arg(

@@ -532,7 +532,6 @@ int main(int argc, char** argv)
 		fitted.corr_growth_x12 = rgx;
 		fitted.corr_y12 = rfy;
 		fitted.corr_growth_y12 = rgy;
-		fitted.clipped_side_sigma_px = fx.clip;
 		fitted.corner_midpoint_ratio = std::sqrt(zm / samples.size());
 		fitted.corner_tilt_ratio = std::sqrt(zt / samples.size());
 		// The same tabulated against size (PoseOptions::sigma_x_table,

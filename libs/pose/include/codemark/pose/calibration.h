@@ -6,7 +6,7 @@
  *
  *   # made by: codemark-bench-pose-calib --renders 1200 ... --out FILE
  *   # data: ...
- *   # date: 2026-12-04T06:00:00Z
+ *   # date: 2026/12/04,06:31:42.655778
  *   [pose]
  *   sigma_px = 0.0238
  *   ...
