@@ -142,7 +142,16 @@ int main(int argc, char** argv)
 												   std::to_string(s.metrics->ate_rmse_anchored_m) +
 												   " m anchored at the true start)"
 											 : std::string());
-		std::cout << "; wrote " << req.out_dir << "\n";
+		std::cout << "; wrote " << req.out_dir << "; innovations: mean NIS " << s.nis_mean
+				  << " for " << s.nis_dof << " DoF over " << s.nis_count << " sightings, "
+				  << 100.0 * s.gated_fraction << "% gated: " << s.nis_verdict;
+		if (s.nis_verdict != "consistent" && s.nis_count > 0)
+			std::cout << "; to fit the sighting noise to this run: codemark-calibrate-noise "
+						 "--rawlog "
+					  << req.rawlog << " --map " << (req.map_file.empty() ? "MAP" : req.map_file)
+					  << " --out calibration.ini, then codemark-localize --calibration "
+						 "calibration.ini";
+		std::cout << "\n";
 		return 0;
 	}
 	catch (const TCLAP::ArgException& e)

@@ -259,6 +259,11 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		{
 			const bool accepted = iterate(&s);
 			predict_ = false;  // one prediction per step (FEAT = 0: one landmark per iteration)
+			if (tested_)
+			{
+				innovation_.id = s.s->id;
+				st.innovations.push_back(innovation_);
+			}
 			if (accepted)
 			{
 				++st.used;
@@ -310,6 +315,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	{
 		current_ = s;
 		accepted_ = false;
+		tested_ = false;
 		if (s)
 		{
 			if (kind_ == EkfMeasurement::Landmark)
@@ -469,9 +475,9 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		for (int i = 0; i < 3; ++i) nu[i] = z_[i];
 		OnSubstractObservationVectors(nu, pred.at(0));
 		const Eigen::Matrix3d Se = S.asEigen().block<3, 3>(0, 0);
-		const Eigen::Vector3d v(nu[0], nu[1], nu[2]);
-		const double d2 = v.dot(Se.ldlt().solve(v));
-		if (!std::isfinite(d2) || d2 > gate_) return;
+		innovation_ = makeInnovation(Eigen::Vector3d(nu[0], nu[1], nu[2]), Se, gate_);
+		tested_ = true;
+		if (innovation_.gated) return;
 		KFArray_OBS z;
 		for (int i = 0; i < 3; ++i) z[i] = z_[i];
 		out_z.push_back(z);
@@ -504,6 +510,8 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	Eigen::Vector3d z_ = Eigen::Vector3d::Zero();
 	Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
 	bool accepted_ = false;
+	bool tested_ = false;  // the gate saw the current sighting
+	Innovation innovation_;	 // its NIS
 	Eigen::Vector3d x0_ = Eigen::Vector3d::Zero();	// prior of the accepted update
 	Eigen::Matrix3d P0_ = Eigen::Matrix3d::Zero();
 };

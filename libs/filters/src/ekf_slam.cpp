@@ -261,6 +261,7 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 	std::vector<std::size_t> new_queue;	 //!< pass indices of sightings to add, in order
 	mutable std::size_t new_cursor = 0;
 	int used = 0, rejected = 0;
+	std::vector<Innovation> innovations;  //!< of this step's sightings of mapped landmarks
 	std::size_t iterations = 0;
 
 	SlamKF()
@@ -552,8 +553,12 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 			if (k == in_idx_S.size())
 				throw std::logic_error("ekf-slam: sighted landmark not predicted");
 			const MatD S = in_S.asEigen().template block<D, D>(D * k, D * k);
-			const double d2 = w.dot(S.ldlt().solve(w));
-			if (!(d2 <= gateThreshold(opts.gate_probability, (D == 2 || s.point) ? 2 : 3)))
+			const int dof = (D == 2 || s.point) ? 2 : 3;
+			Innovation in = makeInnovation(w, S, gateThreshold(opts.gate_probability, dof));
+			in.dof = dof;  // D = 3 with a point sighting: the third row is unused
+			in.id = s.id;
+			innovations.push_back(in);
+			if (in.gated)
 			{
 				++rejected;
 				continue;
@@ -819,6 +824,7 @@ class EkfSlam::Impl
 	{
 		kf.used = 0;
 		kf.rejected = 0;
+		kf.innovations.clear();
 		if (odometry && odometry->poseChange)
 		{
 			const mrpt::poses::CPosePDFGaussian g(*odometry->poseChange);
@@ -900,6 +906,7 @@ class EkfSlam::Impl
 		kf.checkCovariance();
 		st.used += kf.used;
 		st.rejected += kf.rejected;
+		st.innovations.insert(st.innovations.end(), kf.innovations.begin(), kf.innovations.end());
 		return st;
 	}
 };

@@ -117,8 +117,6 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 	return m;
 }
 
-namespace
-{
 LandmarkMap loadAnyMap(const std::string& path)
 {
 	if (isMrptLandmarksFile(path)) return loadMrptLandmarksFile(path);
@@ -141,6 +139,9 @@ std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg
 	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 	return e;
 }
+
+namespace
+{
 
 std::string num(double v, int decimals = 6)
 {
@@ -175,6 +176,14 @@ void writeTextFiles(const LocalizeSummary& s, const std::string& dir)
 				cov << ' ' << std::setprecision(9) << std::scientific << r.estimate.cov(i, j);
 		cov << std::defaultfloat << '\n';
 	}
+	std::ofstream nis(dir + "/innovations.txt");
+	if (!nis) throw std::runtime_error(dir + "/innovations.txt: cannot write");
+	nis << "# timestamp[UNIX s] nis dof gated(0/1) id: one row per sighting tested against the "
+		   "filter's prediction\n";
+	for (const auto& r : s.rows)
+		for (const auto& in : r.stats.innovations)
+			nis << num(r.timestamp, 6) << ' ' << num(in.nis, 4) << ' ' << in.dof << ' '
+				<< (in.gated ? 1 : 0) << ' ' << in.id << '\n';
 	if (!s.slam_map.empty())
 	{
 		LandmarkMap m;
@@ -330,6 +339,41 @@ void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::str
 }
 }  // namespace
 
+std::string nisVerdict(double nis_mean, double nis_dof, long count)
+{
+	if (count <= 0 || !(nis_dof > 0)) return "no sightings tested";
+	const double k = nis_mean / nis_dof;
+	if (k >= kNisConsistentLow && k <= kNisConsistentHigh) return "consistent";
+	std::ostringstream o;
+	o << std::setprecision(2);
+	if (k > kNisConsistentHigh)
+		o << "covariances too small by about " << k << "x";
+	else
+		o << "covariances too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
+	return o.str();
+}
+
+void summariseInnovations(LocalizeSummary& s)
+{
+	double sum = 0, dof = 0;
+	long n = 0, gated = 0, tested = 0;
+	for (const auto& r : s.rows)
+		for (const auto& in : r.stats.innovations)
+		{
+			++tested;
+			gated += in.gated ? 1 : 0;
+			if (!std::isfinite(in.nis)) continue;
+			sum += in.nis;
+			dof += in.dof;
+			++n;
+		}
+	s.nis_count = n;
+	s.nis_mean = n ? sum / n : 0.0;
+	s.nis_dof = n ? dof / n : 0.0;
+	s.gated_fraction = tested ? double(gated) / double(tested) : 0.0;
+	s.nis_verdict = nisVerdict(s.nis_mean, s.nis_dof, s.nis_count);
+}
+
 std::string summaryJson(const LocalizeSummary& s)
 {
 	std::ostringstream o;
@@ -344,6 +388,11 @@ std::string summaryJson(const LocalizeSummary& s)
 	o << "  \"first_fix_step\": " << s.first_fix_step << ",\n";
 	o << "  \"first_fix_time_s\": " << num(s.first_fix_time_s, 3) << ",\n";
 	o << "  \"detect_ms_per_image\": " << num(s.detect_ms_per_image, 3) << ",\n";
+	o << "  \"nis_mean\": " << num(s.nis_mean, 4) << ",\n";
+	o << "  \"nis_dof\": " << num(s.nis_dof, 3) << ",\n";
+	o << "  \"nis_count\": " << s.nis_count << ",\n";
+	o << "  \"gated_fraction\": " << num(s.gated_fraction, 4) << ",\n";
+	o << "  \"nis_verdict\": \"" << s.nis_verdict << "\",\n";
 	if (s.metrics)
 	{
 		const auto& m = *s.metrics;
@@ -508,6 +557,7 @@ LocalizeSummary runLocalization(
 	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
 	s.detect_ms_per_image = images ? 1000.0 * detect_s / images : 0.0;
 	s.slam_map = filter->landmarks();
+	summariseInnovations(s);
 	// SLAM without a prior map estimates in the frame of the robot's start:
 	// align it to the ground truth's before comparing.
 	s.metrics = computeMetrics(s.rows, slam && map.landmarks.empty());

@@ -1,6 +1,7 @@
 // The particle filter localizer: MRPT's CMonteCarloLocalization2D and
 // CParticleFilter over the coded-landmark map (particle_filter.h).
 #include <codemark/landmark/random.h>
+#include <codemark/filters/ekf.h>
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <codemark/pose/closed_form.h>
@@ -12,6 +13,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -198,23 +200,51 @@ StepStats ParticleFilterLocalizer::step(
 	}
 
 	// Only the observations the map scores (the images stay out of the loop).
-	mrpt::obs::CSensoryFrame sf;
+	// Once converged, each coded sighting is tested against the predicted
+	// measurement distribution (predictedInnovation()) and one beyond the
+	// gate is left out of the update, as the EKFs reject it; before
+	// convergence the likelihood's outlier mixture carries wrong sightings.
+	mrpt::obs::CSensoryFrame sf, all;
 	std::vector<const CObservationCodedLandmarks*> coded;
+	const auto motion = actions.getBestMovementEstimation();
 	for (const auto& o : observations)
 	{
 		if (!o) continue;
 		if (auto c = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
 		{
 			coded.push_back(c.get());
-			for (const auto& s : c->sightings)
-				(m_map->find(s.id) ? stats.used : stats.unknown_id)++;
-			sf.insert(o);
+			all.insert(o);
+			auto kept = std::make_shared<CObservationCodedLandmarks>(*c);
+			kept->sightings.clear();
+			for (const auto& sg : c->sightings)
+			{
+				if (!m_map->find(sg.id))
+				{
+					++stats.unknown_id;
+					continue;
+				}
+				if (m_converged && motion && motion->poseChange)
+				{
+					Innovation in = predictedInnovation(*c, sg, *motion);
+					in.id = sg.id;
+					stats.innovations.push_back(in);
+					if (in.gated)
+					{
+						++stats.rejected;
+						continue;
+					}
+				}
+				++stats.used;
+				kept->sightings.push_back(sg);
+			}
+			if (!kept->sightings.empty()) sf.insert(kept);
 		}
 		else if (auto b = std::dynamic_pointer_cast<mrpt::obs::CObservationBearingRange>(o))
 		{
 			for (const auto& m : b->sensedData)
 				(m_map->find(m.landmarkID) ? stats.used : stats.unknown_id)++;
 			sf.insert(o);
+			all.insert(o);
 		}
 	}
 
@@ -258,14 +288,14 @@ StepStats ParticleFilterLocalizer::step(
 		// the same floor everywhere and its ESS says nothing.
 		const int patience = m_converged ? m_opts.inject_after_unexplained : 1;
 		const bool lost = m_opts.inject_after_unexplained > 0 && m_unexplained >= patience;
-		if ((collapsed || lost) && injectAroundFixes(sf))
+		if ((collapsed || lost) && injectAroundFixes(all))
 		{
 			stats.reinitialized = true;
 			m_unexplained = 0;
 		}
 	}
 
-	// Convergence (sticky) and the sightings the estimate rejects.
+	// Convergence (sticky).
 	const PoseEstimate e = estimate();
 	checkFinite(e);
 	if (!m_converged)
@@ -276,14 +306,60 @@ StepStats ParticleFilterLocalizer::step(
 		m_converged =
 			std_xy < m_opts.converged_std_xy_m && std_yaw < m_opts.converged_std_yaw_deg * kDeg;
 	}
-	if (m_converged && !coded.empty())
-	{
-		const auto [known, out] = gatedOut(e.mean.asTPose());
-		(void)known;
-		stats.rejected = out;
-		stats.used -= out;
-	}
 	return stats;
+}
+
+Innovation ParticleFilterLocalizer::predictedInnovation(
+	const CObservationCodedLandmarks& obs, const CObservationCodedLandmarks::TSighting& sg,
+	const mrpt::obs::CActionRobotMovement2D& motion) const
+{
+	// The particles moved by the odometry's mean; its covariance enters
+	// linearised at the weighted mean (no draws: MRPT's generator stays the
+	// update's alone, so seeded runs do not depend on this statistic).
+	const MapLandmark& lm = *m_map->find(sg.id);
+	const mrpt::poses::CPose2D cam = pose::cameraPlanarPose(obs.cameraPose);
+	const mrpt::poses::CPose2D world_T_lm = pose::landmarkPlanarPose(lm.world_T_landmark());
+	mrpt::math::CMatrixDouble33 Cu;
+	mrpt::poses::CPose2D u;
+	motion.poseChange->getCovarianceAndMean(Cu, u);
+	const Eigen::Vector3d ue(u.x(), u.y(), u.phi());
+	const auto& parts = m_pdf.m_particles;
+	double max_lw = -std::numeric_limits<double>::infinity();
+	for (const auto& p : parts) max_lw = std::max(max_lw, p.log_w);
+	Eigen::Vector3d mean_d = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+	double wsum = 0, sc = 0, ss = 0;
+	Eigen::Vector2d mean_xy = Eigen::Vector2d::Zero();
+	for (const auto& p : parts)
+	{
+		const double w = std::exp(p.log_w - max_lw);
+		const Eigen::Vector3d x = composeMotion(Eigen::Vector3d(p.d.x, p.d.y, p.d.phi), ue);
+		Eigen::Vector3d d = predictLandmarkMeasurement(x, cam, world_T_lm) - sg.L;
+		d[1] = mrpt::math::wrapToPi(d[1]);
+		d[2] = mrpt::math::wrapToPi(d[2]);
+		mean_d += w * d;
+		second += w * d * d.transpose();
+		mean_xy += w * x.head<2>();
+		sc += w * std::cos(x[2]);
+		ss += w * std::sin(x[2]);
+		wsum += w;
+	}
+	Innovation bad;
+	bad.nis = std::numeric_limits<double>::infinity();
+	bad.gated = true;
+	if (!(wsum > 0)) return bad;
+	mean_d /= wsum;
+	const Eigen::Matrix3d spread = second / wsum - mean_d * mean_d.transpose();
+	// The motion noise at the mean predicted pose: Q = G C_u G^T, through H.
+	const mrpt::math::TPose2D m0 = m_pdf.getMeanVal().asTPose();
+	Eigen::Matrix3d G, H;
+	composeMotion(Eigen::Vector3d(m0.x, m0.y, m0.phi), ue, nullptr, &G);
+	predictLandmarkMeasurement(
+		Eigen::Vector3d(mean_xy[0] / wsum, mean_xy[1] / wsum, std::atan2(ss, sc)), cam, world_T_lm,
+		&H);
+	const Eigen::Matrix3d S =
+		spread + H * G * Cu.asEigen() * G.transpose() * H.transpose() + sg.C_L;
+	return makeInnovation(-mean_d, S, m_opts.gate_chi2);
 }
 
 bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& observations)

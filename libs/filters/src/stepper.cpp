@@ -422,7 +422,7 @@ struct RawlogStepper::Impl
 			{
 				try
 				{
-					s.observations.insert(remeasured(*c));
+					s.observations.insert(pipeline::remeasure(*c, pipe));
 				}
 				catch (const std::exception& e)
 				{
@@ -435,25 +435,6 @@ struct RawlogStepper::Impl
 		}
 		dropOblique(s);
 		ready.push_back(std::move(s));
-	}
-
-	// \a c with each sighting measured again from its corners, quality and
-	// camera under the pipeline's options (StepperOptions::remeasure_sightings).
-	CObservationCodedLandmarks::Ptr remeasured(const CObservationCodedLandmarks& c) const
-	{
-		auto copy = std::make_shared<CObservationCodedLandmarks>(c);
-		const CameraModel camera =
-			pipe.camera_override ? *pipe.camera_override : CameraModel(c.camera);
-		for (auto& t : copy->sightings)
-		{
-			Detection d;
-			d.id = t.id;
-			d.corners = t.corners;
-			d.quality = t.quality;
-			t = CObservationCodedLandmarks::TSighting::From(
-				d, pose::measure(d, camera, pipeline::geometryFor(t.id, pipe), pipe.pose));
-		}
-		return copy;
 	}
 
 	// Replaces coded observations that hold sightings beyond

@@ -122,6 +122,23 @@ CObservationCodedLandmarks::Ptr observeImage(
 	return obs;
 }
 
+CObservationCodedLandmarks::Ptr remeasure(
+	const CObservationCodedLandmarks& c, const PipelineOptions& o)
+{
+	auto copy = std::make_shared<CObservationCodedLandmarks>(c);
+	const CameraModel camera = o.camera_override ? *o.camera_override : CameraModel(c.camera);
+	for (auto& t : copy->sightings)
+	{
+		Detection d;
+		d.id = t.id;
+		d.corners = t.corners;
+		d.quality = t.quality;
+		t = CObservationCodedLandmarks::TSighting::From(
+			d, pose::measure(d, camera, geometryFor(t.id, o), o.pose));
+	}
+	return copy;
+}
+
 std::string imagesDirectoryOf(const std::string& rawlog_path)
 {
 	const auto slash = rawlog_path.find_last_of('/');

@@ -28,9 +28,26 @@ struct PoseEstimate
 	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();	//!< covariance of (x, y, yaw)
 };
 
+/** One sighting tested against the filter's predicted measurement: the
+ * evidence of whether the sightings' covariances are honest without ground
+ * truth (docs/design.md, the NIS verdict). */
+struct Innovation
+{
+	/** Normalised innovation squared nu^T S^-1 nu, S the innovation
+	 * covariance (the prediction's spread plus the sighting's covariance). */
+	double nis = 0;
+	int dof = 3;  //!< its degrees of freedom: 3 for L, 2 for range-bearing
+	double log_det_s = 0;  //!< log det S, the Gaussian likelihood's normaliser
+	bool gated = false;	 //!< beyond the gate: not fused (counted in StepStats::rejected)
+	int id = -1;  //!< the sighted landmark's ID
+};
+
 /** What one step did with the frame's sightings. */
 struct StepStats
 {
+	/** The frame's sightings tested against a prediction, fused and gated
+	 * alike (not those that (re)initialised the filter, which had none). */
+	std::vector<Innovation> innovations;
 	int used = 0;  //!< sightings fused
 	int rejected = 0;  //!< sightings gated out (chi-square) or otherwise rejected
 	int unknown_id = 0;	 //!< sightings of IDs not in the map (localization only)
@@ -43,6 +60,12 @@ struct MappedLandmark
 	MapLandmark landmark;  //!< id, x, y, z, yaw
 	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();	//!< covariance of (x, y, yaw) [m, rad]
 };
+
+/** The Innovation of a measurement whose innovation is \a nu (angles
+ * wrapped) with covariance \a S, gated when its NIS exceeds \a gate (a
+ * chi-square quantile). An S that is not positive definite gives an infinite
+ * NIS (gated). */
+Innovation makeInnovation(const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate);
 
 /** One filter. */
 class Localizer

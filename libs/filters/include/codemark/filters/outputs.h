@@ -7,6 +7,7 @@
  * (SLAM), trajectory.png, trajectory.3Dscene, summary.json.
  */
 #include <codemark/filters/localizer.h>
+#include <mrpt/config/CConfigFileBase.h>
 
 #include <Eigen/Core>
 
@@ -103,6 +104,15 @@ struct LocalizeSummary
 	 * [stepper] max_view_angle_deg (not in sightings_rejected). */
 	long sightings_too_oblique = 0;
 	long reinitializations = 0;	 //!< global initialisation and kidnap recoveries
+	/** Innovation consistency over the sightings tested against a
+	 * prediction (fused and gated alike, StepStats::innovations): the mean
+	 * NIS, the mean degrees of freedom, how many were tested, the fraction
+	 * gated out, and the verdict (nisVerdict()). */
+	double nis_mean = 0;
+	double nis_dof = 0;
+	long nis_count = 0;
+	double gated_fraction = 0;
+	std::string nis_verdict;
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
 	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]
@@ -111,6 +121,23 @@ struct LocalizeSummary
 	std::vector<PathRow> rows;
 	std::vector<MappedLandmark> slam_map;  //!< SLAM only
 };
+
+/** The band of nis_mean / nis_dof that reads as consistent: wide, because
+ * consecutive sightings of one landmark share the prediction's error and
+ * are correlated. */
+constexpr double kNisConsistentLow = 0.5, kNisConsistentHigh = 2.0;
+
+/** The verdict on a run's innovations: "consistent" when K = \a nis_mean /
+ * \a nis_dof lies in [kNisConsistentLow, kNisConsistentHigh], else
+ * "covariances too small by about Kx" (K > 2) or "covariances too large by
+ * about (1/K)x" (K < 0.5), K with 2 significant digits; "no sightings tested"
+ * when \a count is 0. */
+std::string nisVerdict(double nis_mean, double nis_dof, long count);
+
+/** Sets \a s's NIS fields (nis_mean, nis_dof, nis_count, gated_fraction,
+ * nis_verdict) from its rows' innovations; infinite NIS (a covariance that
+ * is not positive definite) count as gated and stay out of the mean. */
+void summariseInnovations(LocalizeSummary& s);
 
 /** Metrics of \a rows (those initialised and with truth); none matched: nullopt.
  * \a align_se2: first fit truth_T_estimate (rotation and translation, no
@@ -130,6 +157,15 @@ void addLandmarkErrors(
  * plane, no scale). */
 mrpt::poses::CPose2D alignSE2(
 	const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b);
+
+/** A landmark map from \a path: the spec's format or MRPT's landmark file
+ * (isMrptLandmarksFile()). Throws as LandmarkMap::load(). */
+LandmarkMap loadAnyMap(const std::string& path);
+
+/** The initial pose of a config's [localize] section (initial_pose_known,
+ * initial_x, initial_y [m], initial_yaw_deg, initial_std_xy [m],
+ * initial_std_yaw_deg), or none (global initialisation). */
+std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg);
 
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument

@@ -13,6 +13,7 @@
  */
 #include <codemark/filters/localizer.h>
 #include <codemark/mrpt/CCodedLandmarksMap.h>
+#include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/bayes/CParticleFilter.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/slam/CMonteCarloLocalization2D.h>
@@ -37,9 +38,11 @@ struct ParticleFilterOptions : public mrpt::config::CLoadableOptions
 	/** Inject when the effective sample size before resampling falls below
 	 * this fraction of the particle count (0 disables). */
 	double inject_ess_threshold = 0.02;
-	/** Chi-square gate on a sighting's Mahalanobis distance at the best
-	 * particle (3 DoF; 16.27 = 99.9%): a frame whose sightings all fail it
-	 * at the best particle is "unexplained". */
+	/** Chi-square gate (3 DoF; 16.27 = 99.9%). Once converged, a sighting
+	 * whose NIS against the predicted measurement distribution exceeds it
+	 * is left out of the update and counted as rejected (as the EKFs gate);
+	 * a frame whose sightings all fail it at the best particle after the
+	 * update is "unexplained". */
 	double gate_chi2 = 16.27;
 	/** Inject after this many consecutive unexplained frames once converged
 	 * (kidnapping); before the first convergence after one (0 disables). */
@@ -99,6 +102,16 @@ class ParticleFilterLocalizer : public Localizer
 	 * with samples around the single-landmark fixes of \a observations'
 	 * coded sightings; returns false when it holds no fix. */
 	bool injectAroundFixes(const mrpt::obs::CSensoryFrame& observations);
+
+	/** The innovation of sighting \a sg (of a mapped landmark, in \a obs)
+	 * against the predicted measurement distribution: the particles moved
+	 * by \a motion's mean, the weighted mean and covariance of the L they
+	 * predict, plus the motion's covariance (linearised) and the sighting's
+	 * C_L (as measured, without the likelihood's sigma_scale and floors: the
+	 * statistic judges the sightings' covariances). Gated beyond gate_chi2. */
+	Innovation predictedInnovation(
+		const CObservationCodedLandmarks& obs, const CObservationCodedLandmarks::TSighting& sg,
+		const mrpt::obs::CActionRobotMovement2D& motion) const;
 
    private:
 	/** Throws std::runtime_error when a particle's pose or log-weight, or the

@@ -84,6 +84,13 @@ CObservationCodedLandmarks::Ptr observeImage(
 	const mrpt::obs::CObservationImage& img, const PipelineOptions& o,
 	ImageResult* result_out = nullptr);
 
+/** \a c with each sighting measured again from its stored corners, quality
+ * and camera (\a o's camera_override when set) under \a o's pose options
+ * and landmark sizes: a landmark observation annotated with one calibration,
+ * measured with another. Throws as pose::measure(). */
+CObservationCodedLandmarks::Ptr remeasure(
+	const CObservationCodedLandmarks& c, const PipelineOptions& o);
+
 /** The BGR cv::Mat of an image observation (loading external storage, a
  * relative file name from \a images_dir, or MRPT's
  * CImage::getImagesPathBase() when it is empty); grey images are
