@@ -22,9 +22,10 @@ namespace
 void printStats(const char* what, const codemark::filters::InnovationStats& s)
 {
 	std::printf(
-		"  %-7s mean NIS %.3g for %.3g DoF (ratio %.2f) over %ld sightings, %.1f%% gated\n", what,
-		s.nis_mean, s.nis_dof, s.nis_dof > 0 ? s.nis_mean / s.nis_dof : 0.0, s.tested,
-		s.tested ? 100.0 * double(s.gated) / double(s.tested) : 0.0);
+		"  %-7s mean NIS %.3g for %.3g DoF (ratio %.2f) over %ld sightings, %.1f%% gated, "
+		"sightings %.0f%% of the innovations' covariance\n",
+		what, s.nis_mean, s.nis_dof, s.nis_dof > 0 ? s.nis_mean / s.nis_dof : 0.0, s.tested,
+		s.tested ? 100.0 * double(s.gated) / double(s.tested) : 0.0, 100.0 * s.sighting_share);
 }
 }  // namespace
 

@@ -475,7 +475,8 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		for (int i = 0; i < 3; ++i) nu[i] = z_[i];
 		OnSubstractObservationVectors(nu, pred.at(0));
 		const Eigen::Matrix3d Se = S.asEigen().block<3, 3>(0, 0);
-		innovation_ = makeInnovation(Eigen::Vector3d(nu[0], nu[1], nu[2]), Se, gate_);
+		const Eigen::MatrixXd R = R_;
+		innovation_ = makeInnovation(Eigen::Vector3d(nu[0], nu[1], nu[2]), Se, gate_, &R);
 		tested_ = true;
 		if (innovation_.gated) return;
 		KFArray_OBS z;

@@ -7,7 +7,8 @@
 
 namespace codemark::filters
 {
-Innovation makeInnovation(const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate)
+Innovation makeInnovation(
+	const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate, const Eigen::MatrixXd* R)
 {
 	Innovation in;
 	in.dof = static_cast<int>(nu.size());
@@ -23,6 +24,7 @@ Innovation makeInnovation(const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, d
 	const Eigen::VectorXd d = llt.matrixL().toDenseMatrix().diagonal();
 	in.log_det_s = 2.0 * d.array().log().sum();
 	in.gated = !(in.nis <= gate);
+	if (R) in.sighting_share = llt.solve(*R).trace() / double(in.dof);
 	return in;
 }
 }  // namespace codemark::filters

@@ -23,6 +23,9 @@ namespace
 /** The prior's spread of the ratios of the four scales to one another
  * around the starting calibration's: one standard deviation is this factor. */
 constexpr double kShapePriorFactor = 2.0;
+/** Below this mean share of the sightings in the innovations' covariance
+ * (Innovation::sighting_share) the run cannot tell their noise. */
+constexpr double kMinSightingShare = 0.25;
 
 // The least-squares fit a^2 + b^2 (ref / w)^2 of a sigma table (exponent
 // 1), a^2 and b^2 kept >= 0.
@@ -65,7 +68,7 @@ class RunLikelihood
 		po.pose = o;
 		auto filter = makeEkfLocalizer(EkfMeasurement::Landmark, ekf_, map_, initial_);
 		InnovationStats st;
-		double dof = 0, nis = 0;
+		double dof = 0, nis = 0, share = 0;
 		long finite = 0;
 		for (const auto& step : steps_)
 		{
@@ -85,12 +88,14 @@ class RunLikelihood
 				if (!std::isfinite(in.nis)) continue;
 				nis += in.nis;
 				dof += in.dof;
+				share += in.sighting_share;
 				st.neg_log_likelihood += 0.5 * (in.log_det_s + in.nis);
 				++finite;
 			}
 		}
 		st.nis_mean = finite ? nis / double(finite) : 0.0;
 		st.nis_dof = finite ? dof / double(finite) : 3.0;
+		st.sighting_share = finite ? share / double(finite) : 0.0;
 		// A model under which some innovation has no finite NIS cannot be
 		// the likelihood's optimum.
 		if (finite < st.tested) st.neg_log_likelihood = std::numeric_limits<double>::infinity();
@@ -361,6 +366,15 @@ NoiseFitResult fitSightingNoise(
 				r.warnings.push_back(w.str());
 			}
 		}
+	}
+	if (r.after.sighting_share < kMinSightingShare)
+	{
+		std::ostringstream w;
+		w << "the sightings make only " << std::lround(100 * r.after.sighting_share)
+		  << "% of the innovations' covariance (the odometry's prediction the rest): the run "
+			 "barely sees the sightings' noise (finer odometry, or more landmarks in view at once, "
+			 "help)";
+		r.warnings.push_back(w.str());
 	}
 	if (r.sightings < 30)
 		r.warnings.push_back(

@@ -355,14 +355,15 @@ std::string nisVerdict(double nis_mean, double nis_dof, long count)
 
 void summariseInnovations(LocalizeSummary& s)
 {
-	double sum = 0, dof = 0;
-	long n = 0, gated = 0, tested = 0;
+	double sum = 0, dof = 0, share = 0;
+	long n = 0, gated = 0, tested = 0, shared = 0;
 	for (const auto& r : s.rows)
 		for (const auto& in : r.stats.innovations)
 		{
 			++tested;
 			gated += in.gated ? 1 : 0;
 			if (!std::isfinite(in.nis)) continue;
+			if (std::isfinite(in.sighting_share)) share += in.sighting_share, ++shared;
 			sum += in.nis;
 			dof += in.dof;
 			++n;
@@ -372,6 +373,8 @@ void summariseInnovations(LocalizeSummary& s)
 	s.nis_dof = n ? dof / n : 0.0;
 	s.gated_fraction = tested ? double(gated) / double(tested) : 0.0;
 	s.nis_verdict = nisVerdict(s.nis_mean, s.nis_dof, s.nis_count);
+	s.nis_sighting_share =
+		shared ? share / double(shared) : std::numeric_limits<double>::quiet_NaN();
 }
 
 std::string summaryJson(const LocalizeSummary& s)
@@ -393,6 +396,7 @@ std::string summaryJson(const LocalizeSummary& s)
 	o << "  \"nis_count\": " << s.nis_count << ",\n";
 	o << "  \"gated_fraction\": " << num(s.gated_fraction, 4) << ",\n";
 	o << "  \"nis_verdict\": \"" << s.nis_verdict << "\",\n";
+	o << "  \"nis_sighting_share\": " << num(s.nis_sighting_share, 4) << ",\n";
 	if (s.metrics)
 	{
 		const auto& m = *s.metrics;

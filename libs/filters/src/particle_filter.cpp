@@ -359,7 +359,8 @@ Innovation ParticleFilterLocalizer::predictedInnovation(
 		&H);
 	const Eigen::Matrix3d S =
 		spread + H * G * Cu.asEigen() * G.transpose() * H.transpose() + sg.C_L;
-	return makeInnovation(-mean_d, S, m_opts.gate_chi2);
+	const Eigen::MatrixXd R = sg.C_L;
+	return makeInnovation(-mean_d, S, m_opts.gate_chi2, &R);
 }
 
 bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& observations)

@@ -288,4 +288,20 @@ std::string resolveCalibration(const std::string& path_or_name)
 	return path_or_name;
 }
 
+PoseOptions scaledNoiseModel(const PoseOptions& in, double factor)
+{
+	if (!(factor > 0) || !std::isfinite(factor))
+		throw std::invalid_argument("scaledNoiseModel: the factor must be finite and > 0");
+	PoseOptions o = in;
+	o.sigma_px *= factor;
+	o.sigma_y_px *= factor;
+	o.growth_x_px *= factor;
+	o.growth_y_px *= factor;
+	o.clipped_side_sigma_px *= factor;
+	for (auto* t :
+		 {&o.sigma_x_table, &o.sigma_y_table, &o.noise_sigma_x_table, &o.noise_sigma_y_table})
+		for (auto& entry : *t) entry.second *= factor;
+	return o;
+}
+
 }  // namespace codemark::pose

@@ -13,6 +13,7 @@
 #include <mrpt/poses/CPose2D.h>
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -40,6 +41,11 @@ struct Innovation
 	double log_det_s = 0;  //!< log det S, the Gaussian likelihood's normaliser
 	bool gated = false;	 //!< beyond the gate: not fused (counted in StepStats::rejected)
 	int id = -1;  //!< the sighted landmark's ID
+	/** The sighting's own share of S, tr(S^-1 R) / dof in [0, 1] (R the
+	 * sighting's covariance; the rest is the prediction's): near 0 the
+	 * innovation shows the prediction's error and says little of R. NaN
+	 * when the filter does not report it. */
+	double sighting_share = std::numeric_limits<double>::quiet_NaN();
 };
 
 /** What one step did with the frame's sightings. */
@@ -62,10 +68,13 @@ struct MappedLandmark
 };
 
 /** The Innovation of a measurement whose innovation is \a nu (angles
- * wrapped) with covariance \a S, gated when its NIS exceeds \a gate (a
+ * wrapped) with covariance \a S (of which \a R, when given, is the
+ * measurement's own: sighting_share), gated when its NIS exceeds \a gate (a
  * chi-square quantile). An S that is not positive definite gives an infinite
  * NIS (gated). */
-Innovation makeInnovation(const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate);
+Innovation makeInnovation(
+	const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate,
+	const Eigen::MatrixXd* R = nullptr);
 
 /** One filter. */
 class Localizer

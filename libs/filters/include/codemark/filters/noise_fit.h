@@ -55,6 +55,7 @@ struct InnovationStats
 	double nis_mean = 0;  //!< mean NIS (finite ones)
 	double nis_dof = 3;	 //!< mean degrees of freedom
 	double neg_log_likelihood = 0;	//!< sum of (log det S + NIS) / 2
+	double sighting_share = 0;	//!< mean Innovation::sighting_share
 };
 
 /** What the fit found. */

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,6 +114,9 @@ struct LocalizeSummary
 	long nis_count = 0;
 	double gated_fraction = 0;
 	std::string nis_verdict;
+	/** Mean Innovation::sighting_share (NaN when the filter reports none):
+	 * how much the NIS can say about the sightings' covariances. */
+	double nis_sighting_share = std::numeric_limits<double>::quiet_NaN();
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
 	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]

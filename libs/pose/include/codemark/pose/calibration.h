@@ -41,6 +41,12 @@ PoseOptions loadCalibration(const std::string& path, const PoseOptions& base = P
 void saveCalibration(
 	const std::string& path, const PoseOptions& o, const std::vector<std::string>& provenance);
 
+/** \a o with every standard deviation of its noise model multiplied by \a
+ * factor (C_P by factor^2): sigma_px, sigma_y_px, the growth terms, the
+ * sigma and noise tables, clipped_side_sigma_px. Ratios and correlations
+ * stay. */
+PoseOptions scaledNoiseModel(const PoseOptions& o, double factor);
+
 /** The path of the shipped calibration \a name
  * (share/codemark/calibration/<name>.ini, found as findShareFile() finds
  * files). Throws std::runtime_error naming the folders it looked in when it

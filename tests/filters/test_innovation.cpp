@@ -1,0 +1,106 @@
+// The normalised innovation squared and the verdict on a run's innovations.
+#include <codemark/filters/outputs.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+using namespace codemark::filters;
+
+TEST(Innovation, NisAndLogDetMatchTheirDefinitions)
+{
+	Eigen::Matrix3d A;
+	A << 2, 0.3, -0.1, 0.3, 1, 0.2, -0.1, 0.2, 0.5;
+	const Eigen::Matrix3d S = A * A.transpose();
+	const Eigen::Vector3d nu(0.4, -1.2, 0.7);
+	const Eigen::MatrixXd R = 0.25 * S;
+	const Innovation in = makeInnovation(nu, S, 16.27, &R);
+	EXPECT_NEAR(in.nis, nu.dot(S.inverse() * nu), 1e-12);
+	EXPECT_NEAR(in.log_det_s, std::log(S.determinant()), 1e-12);
+	EXPECT_EQ(in.dof, 3);
+	EXPECT_NEAR(in.sighting_share, 0.25, 1e-12);
+	EXPECT_EQ(in.gated, in.nis > 16.27);
+	EXPECT_TRUE(makeInnovation(10 * nu, S, 1.0).gated);
+	EXPECT_TRUE(std::isnan(makeInnovation(nu, S, 16.27).sighting_share));
+}
+
+TEST(Innovation, NotPositiveDefiniteIsGatedWithInfiniteNis)
+{
+	const Eigen::Matrix2d S = Eigen::Vector2d(1.0, -1.0).asDiagonal();
+	const Innovation in = makeInnovation(Eigen::Vector2d(0.1, 0.1), S, 1e9);
+	EXPECT_TRUE(std::isinf(in.nis));
+	EXPECT_TRUE(in.gated);
+	EXPECT_EQ(in.dof, 2);
+}
+
+// Innovations drawn from the S they are normalised by: mean NIS ~ dof and a
+// consistent verdict; the same innovations judged against S / 9 and S * 9
+// say "too small" and "too large" by about 9.
+TEST(Innovation, VerdictOfDrawnInnovations)
+{
+	std::mt19937 rng(5);
+	std::normal_distribution<double> g;
+	Eigen::Matrix3d A;
+	A << 0.02, 0, 0, 0.001, 0.003, 0, 0.002, -0.001, 0.01;
+	const Eigen::Matrix3d S = A * A.transpose();
+	for (const double k : {1.0, 1.0 / 9.0, 9.0})
+	{
+		LocalizeSummary s;
+		for (int i = 0; i < 2000; ++i)
+		{
+			PathRow r;
+			const Eigen::Vector3d nu = A * Eigen::Vector3d(g(rng), g(rng), g(rng));
+			r.stats.innovations.push_back(makeInnovation(nu, k * S, 16.27));
+			s.rows.push_back(r);
+		}
+		summariseInnovations(s);
+		EXPECT_EQ(s.nis_count, 2000);
+		EXPECT_NEAR(s.nis_dof, 3.0, 1e-12);
+		EXPECT_NEAR(s.nis_mean / s.nis_dof, 1.0 / k, 0.1 / k) << k;
+		if (k == 1.0)
+		{
+			EXPECT_EQ(s.nis_verdict, "consistent");
+			EXPECT_LT(s.gated_fraction, 0.01);
+		}
+		else if (k < 1)
+			EXPECT_EQ(s.nis_verdict.rfind("covariances too small by about ", 0), 0u)
+				<< s.nis_verdict;
+		else
+			EXPECT_EQ(s.nis_verdict.rfind("covariances too large by about ", 0), 0u)
+				<< s.nis_verdict;
+	}
+}
+
+TEST(Innovation, VerdictBandAndWording)
+{
+	EXPECT_EQ(nisVerdict(3.0, 3.0, 10), "consistent");
+	EXPECT_EQ(nisVerdict(1.5, 3.0, 10), "consistent");
+	EXPECT_EQ(nisVerdict(6.0, 3.0, 10), "consistent");
+	EXPECT_EQ(nisVerdict(24.0, 3.0, 10), "covariances too small by about 8x");
+	EXPECT_EQ(nisVerdict(0.75, 3.0, 10), "covariances too large by about 4x");
+	EXPECT_EQ(nisVerdict(0.0, 0.0, 0), "no sightings tested");
+}
+
+// Infinite NIS count as gated and stay out of the mean.
+TEST(Innovation, SummaryKeepsInfiniteNisOutOfTheMean)
+{
+	LocalizeSummary s;
+	PathRow r;
+	Innovation a;
+	a.nis = 2;
+	a.dof = 2;
+	Innovation b;
+	b.nis = std::numeric_limits<double>::infinity();
+	b.gated = true;
+	r.stats.innovations = {a, b};
+	s.rows.push_back(r);
+	summariseInnovations(s);
+	EXPECT_EQ(s.nis_count, 1);
+	EXPECT_DOUBLE_EQ(s.nis_mean, 2.0);
+	EXPECT_DOUBLE_EQ(s.gated_fraction, 0.5);
+	const std::string json = summaryJson(s);
+	for (const char* key :
+		 {"\"nis_mean\"", "\"nis_dof\"", "\"nis_count\"", "\"gated_fraction\"", "\"nis_verdict\""})
+		EXPECT_NE(json.find(key), std::string::npos) << key;
+}
