@@ -242,6 +242,7 @@ JobResult runJob(
 		// start: its ATE and NEES after the alignment (NEES anchored at the
 		// true first pose), as codemark-localize reports them.
 		s.metrics = filters::computeMetrics(s.rows, prior.landmarks.empty());
+		filters::summariseInnovations(s);
 		r.rpe = relativePoseError(s.rows, cfg.rpe_interval_s);
 		r.aligned = alignPath(s.rows);
 		filters::writeOutputs(s, map, out_dir);

@@ -46,6 +46,7 @@ int main(int argc, char** argv)
 			"One job per dataset x method runs on a pool of threads. Writes into --out DIR: "
 			"results.csv (one row per job), report.md (tables, definitions, plots), "
 			"<dataset>-error.png (position error against time with the filter's 3-sigma bound), "
+			"<dataset>-nis.png (each sighting's NIS per degree of freedom against time), "
 			"<dataset>-trajectories.png (estimates, ground truth, landmarks), and each job's "
 			"codemark-localize outputs in <dataset>/<method>/. Exits non-zero if any job failed.",
 			' ', "0.1");

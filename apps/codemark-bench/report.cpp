@@ -59,7 +59,8 @@ std::string csvHeader()
 		   "deg,"
 		   "nees_mean,nees_low_95,nees_high_95,nees_inside,first_fix_step,first_fix_s,sightings_"
 		   "used,"
-		   "sightings_rejected,filter_ms_per_step,wall_s,error";
+		   "sightings_rejected,filter_ms_per_step,wall_s,error,nis_mean,nis_dof,nis_count,gated_"
+		   "fraction,nis_verdict";
 }
 
 std::string csvRow(const JobResult& r)
@@ -81,7 +82,8 @@ std::string csvRow(const JobResult& r)
 	  << (m ? (neesInside(*m) ? "yes" : "no") : "") << ',' << s.first_fix_step << ','
 	  << (s.first_fix_step >= 0 ? fmt(s.first_fix_time_s, 2) : "") << ',' << s.sightings_used << ','
 	  << s.sightings_rejected << ',' << fmt(s.time_per_step_ms, 4) << ',' << fmt(r.wall_s, 2) << ','
-	  << clean(r.error);
+	  << clean(r.error) << ',' << fmt(s.nis_mean, 4) << ',' << fmt(s.nis_dof, 3) << ','
+	  << s.nis_count << ',' << fmt(s.gated_fraction, 4) << ',' << clean(s.nis_verdict);
 	return o.str();
 }
 
@@ -143,6 +145,62 @@ void drawErrorPanel(
 		cv::Point(box.x, box.y - 7), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
 		cv::LINE_AA);
 }
+
+// A panel of a NIS plot: each sighting's NIS over its degrees of freedom
+// (dots, log scale) and its mean over the last 5 s (line) against time,
+// with the consistent band [0.5, 2] of the run's mean.
+void drawNisPanel(
+	cv::Mat& img, const cv::Rect& box, const JobResult& r, double t0, double t1,
+	const cv::Scalar& colour)
+{
+	constexpr double lo = 0.01, hi = 100.0;
+	cv::rectangle(img, box, cv::Scalar(0, 0, 0));
+	auto px = [&](double t, double v)
+	{
+		const double f = (std::log10(std::clamp(v, lo, hi)) - std::log10(lo)) /
+						 (std::log10(hi) - std::log10(lo));
+		return cv::Point(
+			box.x + static_cast<int>((t - t0) / (t1 - t0) * box.width),
+			box.y + box.height - static_cast<int>(f * box.height));
+	};
+	for (const double v : {filters::kNisConsistentLow, filters::kNisConsistentHigh})
+		cv::line(img, px(t0, v), px(t1, v), cv::Scalar(150, 200, 150), 2);
+	// Decades, labelled at the right edge below their line.
+	for (const double v : {0.01, 0.1, 1.0, 10.0})
+	{
+		cv::line(img, px(t0, v), px(t1, v), cv::Scalar(225, 225, 225));
+		cv::putText(
+			img, fmt(v, v < 0.1 ? 2 : (v < 1 ? 1 : 0)), px(t1, v) + cv::Point(-32, -3),
+			cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
+	}
+	const double every_s = t1 - t0 > 120 ? 30 : 5;
+	for (double t = every_s; t < t1 - t0; t += every_s)
+		cv::putText(
+			img, fmt(t, 0) + " s", px(t0 + t, lo) + cv::Point(2, -3), cv::FONT_HERSHEY_SIMPLEX,
+			0.33, cv::Scalar(140, 140, 140), 1, cv::LINE_AA);
+	std::vector<std::pair<double, double>> points;	// time, NIS / DoF
+	for (const auto& row : r.summary.rows)
+		for (const auto& in : row.stats.innovations)
+			if (std::isfinite(in.nis) && in.dof > 0)
+				points.emplace_back(row.timestamp, in.nis / in.dof);
+	std::vector<cv::Point> mean_line;
+	for (std::size_t i = 0; i < points.size(); ++i)
+	{
+		const auto& [t, v] = points[i];
+		cv::circle(img, px(t, v), 2, colour, cv::FILLED, cv::LINE_AA);
+		double sum = 0;
+		int n = 0;
+		for (std::size_t j = i + 1; j-- > 0 && points[j].first > t - 5.0;)
+			sum += points[j].second, ++n;
+		mean_line.push_back(px(t, sum / n));
+	}
+	if (mean_line.size() > 1)
+		cv::polylines(img, mean_line, false, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+	cv::putText(
+		img, r.method + ": each sighting (dots), mean over 5 s (black); " + r.summary.nis_verdict,
+		cv::Point(box.x, box.y - 7), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
+		cv::LINE_AA);
+}
 }  // namespace
 
 std::vector<std::string> writeDatasetPlots(
@@ -195,6 +253,23 @@ std::vector<std::string> writeDatasetPlots(
 	if (!cv::imwrite(dir + "/" + err_file, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
 		throw std::runtime_error(dir + "/" + err_file + ": cannot write");
 	files.push_back(err_file);
+
+	// Innovation consistency against time, one panel per method.
+	cv::Mat nis(
+		top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3, cv::Scalar(255, 255, 255));
+	cv::putText(
+		nis,
+		name + ": NIS / DoF against time [" + fmt(t1 - t0, 0) +
+			" s], log scale; green: the band [0.5, 2] of a consistent mean",
+		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+	for (std::size_t k = 0; k < ok.size(); ++k)
+		drawNisPanel(
+			nis, cv::Rect(10, top + static_cast<int>(k) * (ph + margin), W - 20, ph), *ok[k], t0,
+			t1, kMethodColours[k % 6]);
+	const std::string nis_file = name + "-nis.png";
+	if (!cv::imwrite(dir + "/" + nis_file, nis, {cv::IMWRITE_PNG_COMPRESSION, 9}))
+		throw std::runtime_error(dir + "/" + nis_file + ": cannot write");
+	files.push_back(nis_file);
 
 	// Trajectories: ground truth, every method, the landmarks.
 	const LandmarkMap map = filters::isMrptLandmarksFile(map_file)
@@ -351,8 +426,8 @@ std::string markdownReport(
 		 "ms/frame | ATE [m] | "
 		 "ATE aligned [m] | max err [m] | RPE [m] | RPE yaw [deg] | yaw RMSE [deg] | mean NEES "
 		 "[95% band] | "
-		 "first fix [s] | filter ms/step | wall [s] |\n";
-	o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+		 "first fix [s] | filter ms/step | wall [s] | NIS/DoF: verdict |\n";
+	o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 	for (const auto& r : results)
 	{
 		const auto& s = r.summary;
@@ -360,7 +435,7 @@ std::string markdownReport(
 		if (!r.ok)
 		{
 			o << "| " << r.dataset << " | " << r.method << " | error: " << clean(r.error)
-			  << " | | | | | | | | | | | | | | " << fmt(r.wall_s, 1) << " |\n";
+			  << " | | | | | | | | | | | | | | " << fmt(r.wall_s, 1) << " | |\n";
 			continue;
 		}
 		const auto& m = s.metrics;
@@ -383,7 +458,9 @@ std::string markdownReport(
 		else
 			o << "–";
 		o << " | " << (s.first_fix_step >= 0 ? fmt(s.first_fix_time_s, 1) : "never") << " | "
-		  << fmt(s.time_per_step_ms, 3) << " | " << fmt(r.wall_s, 1) << " |\n";
+		  << fmt(s.time_per_step_ms, 3) << " | " << fmt(r.wall_s, 1) << " | "
+		  << (s.nis_count ? fmt(s.nis_mean / s.nis_dof, 2) + ": " : std::string()) << s.nis_verdict
+		  << " |\n";
 	}
 
 	o << "\n## Definitions\n\n"

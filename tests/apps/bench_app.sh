@@ -26,6 +26,7 @@ INI
 csv=$tmp/out2/results.csv
 test -s "$tmp/out2/report.md"
 test -s "$tmp/out2/images-error.png" && test -s "$tmp/out2/images-trajectories.png"
+test -s "$tmp/out2/images-nis.png" && grep -q "images-nis.png" "$tmp/out2/report.md"
 test -s "$tmp/out2/images/ekf/estimated_path.txt" && test -s "$tmp/out2/annotated/pf/summary.json"
 grep -q "images-error.png" "$tmp/out2/report.md"
 
@@ -43,7 +44,8 @@ want = ["dataset", "method", "status", "steps", "frames_in_view", "detection_rat
         "sighting_detection_rate", "wrong_ids", "detect_ms_per_frame", "ate_m", "ate_aligned_m",
         "max_error_m", "rpe_trans_m", "rpe_yaw_deg", "yaw_rmse_deg", "nees_mean", "nees_low_95",
         "nees_high_95", "nees_inside", "first_fix_step", "first_fix_s", "sightings_used",
-        "sightings_rejected", "filter_ms_per_step", "wall_s", "error"]
+        "sightings_rejected", "filter_ms_per_step", "wall_s", "error", "nis_mean", "nis_dof",
+        "nis_count", "gated_fraction", "nis_verdict"]
 with open(sys.argv[1]) as f:
     header = f.readline().strip().split(",")
 assert header == want, f"columns {header}"
@@ -53,7 +55,7 @@ assert {(r["dataset"], r["method"]) for r in rows} == {
 numeric = ["steps", "frames_in_view", "detection_rate", "sighting_detection_rate", "wrong_ids",
            "ate_m", "ate_aligned_m", "max_error_m", "rpe_trans_m", "rpe_yaw_deg", "yaw_rmse_deg",
            "nees_mean", "nees_low_95", "nees_high_95", "first_fix_s", "sightings_used",
-           "filter_ms_per_step", "wall_s"]
+           "filter_ms_per_step", "wall_s", "nis_mean", "nis_dof", "nis_count", "gated_fraction"]
 for r in rows:
     name = r["dataset"] + "/" + r["method"]
     assert r["status"] == "ok", f"{name}: {r['error']}"
