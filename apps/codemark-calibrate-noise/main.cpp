@@ -19,13 +19,15 @@
 
 namespace
 {
-void printStats(const char* what, const codemark::filters::InnovationStats& s)
+void printStats(const char* what, const codemark::filters::InnovationSummary& s)
 {
 	std::printf(
 		"  %-7s mean NIS %.3g for %.3g DoF (ratio %.2f) over %ld sightings, %.1f%% gated, "
-		"sightings %.0f%% of the innovations' covariance\n",
+		"sightings %.0f%% of the innovations' covariance; first sightings of %ld visits %.2f, "
+		"the others %.2f\n",
 		what, s.nis_mean, s.nis_dof, s.nis_dof > 0 ? s.nis_mean / s.nis_dof : 0.0, s.tested,
-		s.tested ? 100.0 * double(s.gated) / double(s.tested) : 0.0, 100.0 * s.sighting_share);
+		s.tested ? 100.0 * double(s.gated) / double(s.tested) : 0.0, 100.0 * s.sighting_share,
+		s.visits, s.visit_ratio, s.other_ratio);
 }
 }  // namespace
 

@@ -145,7 +145,17 @@ int main(int argc, char** argv)
 		std::cout << "; wrote " << req.out_dir << "; innovations: mean NIS " << s.nis_mean
 				  << " for " << s.nis_dof << " DoF over " << s.nis_count << " sightings, "
 				  << 100.0 * s.gated_fraction << "% gated: " << s.nis_verdict;
-		if (s.nis_verdict != "consistent" && s.nis_count > 0)
+		// With persistent errors the visits' first sightings judge the
+		// sightings' covariances; the others show only how errors change.
+		const double judged = s.persistent_errors ? s.nis_visit_ratio
+												  : (s.nis_dof > 0 ? s.nis_mean / s.nis_dof : 1.0);
+		if (s.persistent_errors)
+			std::cout << "; but the first sightings of " << s.nis_visits
+					  << " landmark visits read NIS/DoF " << s.nis_visit_ratio
+					  << ": the sightings' errors persist from frame to frame, and the NIS over "
+						 "all sightings understates them";
+		if (s.nis_count > 0 && (judged > codemark::filters::kNisConsistentHigh ||
+								judged < codemark::filters::kNisConsistentLow))
 			std::cout << "; to fit the sighting noise to this run: codemark-calibrate-noise "
 						 "--rawlog "
 					  << req.rawlog << " --map " << (req.map_file.empty() ? "MAP" : req.map_file)

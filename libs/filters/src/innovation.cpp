@@ -1,7 +1,10 @@
 // The normalised innovation squared of one sighting, shared by every filter.
 #include <codemark/filters/localizer.h>
 
+#include <mrpt/math/distributions.h>
+
 #include <Eigen/Cholesky>
+#include <set>
 #include <cmath>
 #include <limits>
 
@@ -27,4 +30,48 @@ Innovation makeInnovation(
 	if (R) in.sighting_share = llt.solve(*R).trace() / double(in.dof);
 	return in;
 }
+InnovationSummary summariseInnovations(const std::vector<const std::vector<Innovation>*>& steps)
+{
+	InnovationSummary r;
+	double sum = 0, dof = 0, share = 0, visit_nis = 0, visit_dof = 0, other_nis = 0, other_dof = 0;
+	long shared = 0;
+	std::set<int> before;
+	for (const auto* step : steps)
+	{
+		std::set<int> now;
+		for (const auto& in : *step)
+		{
+			++r.tested;
+			r.gated += in.gated ? 1 : 0;
+			now.insert(in.id);
+			if (!std::isfinite(in.nis))
+			{
+				r.neg_log_likelihood = std::numeric_limits<double>::infinity();
+				continue;
+			}
+			++r.count;
+			sum += in.nis;
+			dof += in.dof;
+			r.neg_log_likelihood += 0.5 * (in.log_det_s + in.nis);
+			if (std::isfinite(in.sighting_share)) share += in.sighting_share, ++shared;
+			if (!before.count(in.id))
+				++r.visits, visit_nis += in.nis, visit_dof += in.dof;
+			else
+				other_nis += in.nis, other_dof += in.dof;
+		}
+		before = std::move(now);
+	}
+	if (r.count == 0) return r;
+	r.nis_mean = sum / double(r.count);
+	r.nis_dof = dof / double(r.count);
+	if (shared) r.sighting_share = share / double(shared);
+	r.visit_ratio = visit_dof > 0 ? visit_nis / visit_dof : 0.0;
+	r.other_ratio = other_dof > 0 ? other_nis / other_dof : 0.0;
+	// Under "the visits' NIS have the others' scale", visit_nis / other_ratio
+	// is chi-square with visit_dof degrees of freedom.
+	r.persistent_errors = r.visits >= 3 && r.other_ratio > 0 &&
+						  visit_nis / r.other_ratio > mrpt::math::chi2inv(0.99, visit_dof);
+	return r;
+}
+
 }  // namespace codemark::filters

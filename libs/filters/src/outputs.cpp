@@ -355,26 +355,18 @@ std::string nisVerdict(double nis_mean, double nis_dof, long count)
 
 void summariseInnovations(LocalizeSummary& s)
 {
-	double sum = 0, dof = 0, share = 0;
-	long n = 0, gated = 0, tested = 0, shared = 0;
-	for (const auto& r : s.rows)
-		for (const auto& in : r.stats.innovations)
-		{
-			++tested;
-			gated += in.gated ? 1 : 0;
-			if (!std::isfinite(in.nis)) continue;
-			if (std::isfinite(in.sighting_share)) share += in.sighting_share, ++shared;
-			sum += in.nis;
-			dof += in.dof;
-			++n;
-		}
-	s.nis_count = n;
-	s.nis_mean = n ? sum / n : 0.0;
-	s.nis_dof = n ? dof / n : 0.0;
-	s.gated_fraction = tested ? double(gated) / double(tested) : 0.0;
+	std::vector<const std::vector<Innovation>*> steps;
+	for (const auto& r : s.rows) steps.push_back(&r.stats.innovations);
+	const InnovationSummary n = summariseInnovations(steps);
+	s.nis_count = n.count;
+	s.nis_mean = n.nis_mean;
+	s.nis_dof = n.nis_dof;
+	s.gated_fraction = n.tested ? double(n.gated) / double(n.tested) : 0.0;
 	s.nis_verdict = nisVerdict(s.nis_mean, s.nis_dof, s.nis_count);
-	s.nis_sighting_share =
-		shared ? share / double(shared) : std::numeric_limits<double>::quiet_NaN();
+	s.nis_sighting_share = n.sighting_share;
+	s.nis_visits = n.visits;
+	s.nis_visit_ratio = n.visit_ratio;
+	s.persistent_errors = n.persistent_errors;
 }
 
 std::string summaryJson(const LocalizeSummary& s)
@@ -397,6 +389,9 @@ std::string summaryJson(const LocalizeSummary& s)
 	o << "  \"gated_fraction\": " << num(s.gated_fraction, 4) << ",\n";
 	o << "  \"nis_verdict\": \"" << s.nis_verdict << "\",\n";
 	o << "  \"nis_sighting_share\": " << num(s.nis_sighting_share, 4) << ",\n";
+	o << "  \"nis_visits\": " << s.nis_visits << ",\n";
+	o << "  \"nis_visit_ratio\": " << num(s.nis_visit_ratio, 4) << ",\n";
+	o << "  \"persistent_errors\": " << (s.persistent_errors ? "true" : "false") << ",\n";
 	if (s.metrics)
 	{
 		const auto& m = *s.metrics;

@@ -76,6 +76,33 @@ Innovation makeInnovation(
 	const Eigen::VectorXd& nu, const Eigen::MatrixXd& S, double gate,
 	const Eigen::MatrixXd* R = nullptr);
 
+/** A run's innovations summarised (Innovation per sighting, one list per
+ * step). A landmark's visit starts with a sighting of an ID that the step
+ * before did not test: its innovation carries the whole of the sighting's
+ * error, while those of the visit's next sightings show only how the error
+ * changed since, since the filter has absorbed the rest. */
+struct InnovationSummary
+{
+	long tested = 0;  //!< sightings tested against a prediction
+	long gated = 0;	 //!< of them, beyond the gate
+	long count = 0;	 //!< of them, with a finite NIS (the means' count)
+	double nis_mean = 0;  //!< mean NIS
+	double nis_dof = 0;	 //!< mean degrees of freedom
+	double sighting_share = std::numeric_limits<double>::quiet_NaN();  //!< mean sighting_share
+	double neg_log_likelihood = 0;	//!< sum of (log det S + NIS) / 2 (infinite NIS: +inf)
+	long visits = 0;  //!< first sightings of a visit (finite NIS)
+	double visit_ratio = 0;	 //!< their mean NIS / DoF
+	double other_ratio = 0;	 //!< the other sightings' mean NIS / DoF
+	/** The visits' NIS exceed the others' beyond chance (their sum, over
+	 * other_ratio, above chi2inv(0.99) of their degrees of freedom): the
+	 * sightings' errors persist from frame to frame, and the NIS over all
+	 * sightings understates them. */
+	bool persistent_errors = false;
+};
+
+/** Summarises \a steps (each step's innovations, in order). */
+InnovationSummary summariseInnovations(const std::vector<const std::vector<Innovation>*>& steps);
+
 /** One filter. */
 class Localizer
 {

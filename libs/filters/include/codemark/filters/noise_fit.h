@@ -47,17 +47,6 @@ struct NoiseScales
 	double growth_y_px = 0;	 //!< size-dependent part of y1, y2 (growth_y_px)
 };
 
-/** The innovations' consistency under one model. */
-struct InnovationStats
-{
-	long tested = 0;  //!< sightings tested against the prediction
-	long gated = 0;	 //!< of them, beyond the gate
-	double nis_mean = 0;  //!< mean NIS (finite ones)
-	double nis_dof = 3;	 //!< mean degrees of freedom
-	double neg_log_likelihood = 0;	//!< sum of (log det S + NIS) / 2
-	double sighting_share = 0;	//!< mean Innovation::sighting_share
-};
-
 /** What the fit found. */
 struct NoiseFitResult
 {
@@ -68,7 +57,7 @@ struct NoiseFitResult
 	 * from the likelihood's curvature at the optimum, in NoiseScales' order;
 	 * optimistic, since consecutive innovations are correlated. */
 	Eigen::Vector4d relative_std = Eigen::Vector4d::Zero();
-	InnovationStats before, after;
+	InnovationSummary before, after;  //!< under the start and the fitted model
 	long steps = 0;	 //!< camera frames of the run
 	long sightings = 0;	 //!< coded sightings of mapped landmarks
 	double width_min_px = 0, width_max_px = 0;	//!< the sightings' apparent widths

@@ -117,6 +117,12 @@ struct LocalizeSummary
 	/** Mean Innovation::sighting_share (NaN when the filter reports none):
 	 * how much the NIS can say about the sightings' covariances. */
 	double nis_sighting_share = std::numeric_limits<double>::quiet_NaN();
+	/** First sightings of a landmark visit, their mean NIS / DoF, and
+	 * whether it exceeds the others' beyond chance
+	 * (InnovationSummary::persistent_errors). */
+	long nis_visits = 0;
+	double nis_visit_ratio = 0;
+	bool persistent_errors = false;
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
 	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]
