@@ -1,6 +1,6 @@
 /** \file main.cpp
  * codemark-detect: runs the landmark detector on images, folders of images
- * and videos, and prints one JSON object per image (landmark-spec.md
+ * and videos, and prints one JSON object per image (docs/spec.md
  * section 5). Parses the command line and calls codemark::detect::detect().
  */
 #include "calibration.h"
@@ -291,7 +291,7 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"Detects coded landmarks (landmark-spec.md) in images with the detector of Baczyk, "
+			"Detects coded landmarks (docs/spec.md) in images with the detector of Baczyk, "
 			"Kasinski and Skrzypczynski (2003) and prints one JSON object per image on its own "
 			"line (spec section 5): {\"image\", \"width\", \"height\", \"time_ms\", "
 			"\"detections\": "

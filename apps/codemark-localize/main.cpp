@@ -1,5 +1,5 @@
 // codemark-localize: runs one filter (ekf, ekf-pose, ekf-slam, pf) over a
-// rawlog and writes the outputs of landmark-spec.md section 6. The logic is
+// rawlog and writes the outputs of docs/spec.md section 6. The logic is
 // codemark::filters::runLocalization (libs/filters/src/outputs.cpp).
 #include <codemark/filters/outputs.h>
 #include <mrpt/core/exceptions.h>

@@ -17,7 +17,7 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"Writes coded landmarks (landmark-spec.md section 1) at exact physical size: "
+			"Writes coded landmarks (docs/spec.md section 1) at exact physical size: "
 			"a 200 mm black frame around a 160 mm #00FF00 square (the reference square) "
 			"holding the 3x3 code board of 30 mm cells, a white quiet margin of at least "
 			"5 mm, and below it, outside the margin, the label \"codemark ID <id> (scale <s>, "

@@ -17,7 +17,7 @@ TEST(Codebook, RoundTripAllIds)
 
 TEST(Codebook, SpecBitOrder)
 {
-	// r0c0 is bit 7, r2c2 is bit 0 (landmark-spec.md section 1).
+	// r0c0 is bit 7, r2c2 is bit 0 (docs/spec.md section 1).
 	const CodeCells c128 = encodeId(128);
 	EXPECT_TRUE(c128[0][0]);
 	EXPECT_FALSE(c128[2][2]);

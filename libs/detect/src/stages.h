@@ -1,6 +1,6 @@
 #pragma once
 /** \file stages.h
- * Internal: one function per stage of the detector (paper-notes "Landmark
+ * Internal: one function per stage of the detector (docs/design.md, "The
  * recognition"), declared here so that tests can run a single stage on a
  * crafted input. detect() in detector.cpp calls them in this order.
  */

@@ -1,4 +1,4 @@
-// Ground-truth path files (landmark-spec.md section 6, both forms).
+// Ground-truth path files (docs/spec.md section 6, both forms).
 #include <codemark/filters/ground_truth.h>
 #include <codemark/landmark/text.h>
 

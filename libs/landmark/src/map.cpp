@@ -93,7 +93,7 @@ LandmarkMap LandmarkMap::load(const std::string& path)
 
 void LandmarkMap::write(std::ostream& out) const
 {
-	out << "# codemark landmark map (landmark-spec.md section 3)\n"
+	out << "# codemark landmark map (docs/spec.md section 3)\n"
 		<< "# id  x[m]  y[m]  z[m]  yaw[deg]  [scale]\n";
 	out << std::setprecision(10);
 	for (const auto& l : landmarks)

@@ -1,5 +1,5 @@
 // Registers every serializable class of the plugin once, when the library is
-// loaded (IMPLEMENTS_SERIALIZABLE does not register; mrpt-notes.md).
+// loaded (IMPLEMENTS_SERIALIZABLE does not register in MRPT 2.5.8).
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <mrpt/core/initializer.h>

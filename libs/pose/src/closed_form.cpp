@@ -51,7 +51,7 @@ Eigen::Vector3d landmarkFromPrimary(
 
 Eigen::Vector3d poseFromLandmark(const Eigen::Vector3d& L, Eigen::Matrix3d* J_L)
 {
-	// Paper eq. 12-14 in the spec's convention (landmark-spec.md section 4).
+	// Paper eq. 12-14 in the spec's convention (docs/spec.md section 4).
 	const double l2 = L[0], a = L[1] + L[2];
 	const double c = std::cos(a), sn = std::sin(a);
 	if (J_L)

@@ -1,7 +1,7 @@
 #pragma once
 /** \file detector.h
  * The landmark detector of Baczyk, Kasinski and Skrzypczynski (2003),
- * section 2.2 (paper-notes "Landmark recognition"): colour segmentation,
+ * section 2.2 (docs/design.md, "The detector"): colour segmentation,
  * components, edgels, segments, quadrangles, sub-pixel corners, code.
  */
 #include <codemark/detect/options.h>

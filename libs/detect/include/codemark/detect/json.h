@@ -1,6 +1,6 @@
 #pragma once
 /** \file json.h
- * The detector's JSON Lines output (landmark-spec.md section 5): one object
+ * The detector's JSON Lines output (docs/spec.md section 5): one object
  * per image, `{"image", "width", "height", "time_ms", "detections": [{"id",
  * "corners", "P", ...}]}` or `{"image", "error"}`.
  */

@@ -70,7 +70,7 @@ struct EkfOptions : public mrpt::config::CLoadableOptions
 		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };
 
-/** The L = [l2 phi1 phi2] (landmark-spec.md section 4) that a camera
+/** The L = [l2 phi1 phi2] (docs/spec.md section 4) that a camera
  * mounted at \a robot_T_camera (planar: optical centre and optical-axis
  * heading, pose::cameraPlanarPose()) on a robot at \a world_T_robot = (x, y,
  * yaw) sees of a landmark at planar pose \a world_T_landmark. phi1, phi2

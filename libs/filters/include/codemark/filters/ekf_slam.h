@@ -5,7 +5,7 @@
  * every mapped landmark's (x, y, yaw) in the map frame [m, m, rad].
  *
  * - Measurements: each coded-landmark sighting's L = [l2 phi1 phi2] with its
- *   own C_L (landmark-spec.md section 4), and each
+ *   own C_L (docs/spec.md section 4), and each
  *   mrpt::obs::CObservationBearingRange reading with a landmark ID as
  *   z = [range, yaw, 0] (the reading's covariance when validCovariances,
  *   else the ini's std_sensor_range / std_sensor_yaw). A point landmark has
@@ -120,7 +120,7 @@ struct EkfSlamOptions : public mrpt::config::CLoadableOptions
  * range-bearing readings: the sensor's planar pose in the world is
  * s = robot (+) sensor_on_robot, d = landmark_xy - s_xy, and
  *   h = [ |d|, wrap(atan2(d) - s_yaw), wrap(s_yaw - landmark_yaw - pi) ]
- * i.e. [l2 phi1 phi2] of landmark-spec.md section 4 (for range-bearing data
+ * i.e. [l2 phi1 phi2] of docs/spec.md section 4 (for range-bearing data
  * the first two are range and yaw; the third is not used).
  * \param robot (x, y, yaw) of the robot in the map [m, m, rad].
  * \param sensor_on_robot planar pose of the sensor (camera: optical centre

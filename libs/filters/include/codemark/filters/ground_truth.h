@@ -1,7 +1,7 @@
 #pragma once
 /** \file ground_truth.h
  * Ground-truth robot paths for codemark-localize --gt, in both forms of
- * landmark-spec.md section 6:
+ * docs/spec.md section 6:
  *  - `timestamp x y yaw` rows (UNIX s, m, m, rad; `#` or `%` comments):
  *    matched to steps by timestamp (codemark-simul's gt_path.txt);
  *  - MRPT robot-path files, `x y z yaw pitch roll` rows with `%` comments

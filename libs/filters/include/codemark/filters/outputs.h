@@ -2,7 +2,7 @@
 /** \file outputs.h
  * The logic of codemark-localize: read a rawlog step by step
  * (RawlogStepper), run one filter (makeLocalizer), and write the outputs of
- * landmark-spec.md section 6 into a folder: estimated_path.txt,
+ * docs/spec.md section 6 into a folder: estimated_path.txt,
  * estimated_path.tum, covariances.txt, map.txt and map_covariances.txt
  * (SLAM), trajectory.png, trajectory.3Dscene, summary.json.
  */

@@ -1,7 +1,7 @@
 #pragma once
 /** \file camera.h
  * A pinhole camera with optional plumb_bob lens distortion, over MRPT's
- * mrpt::img::TCamera (landmark-spec.md section 2). Loaded from MRPT's
+ * mrpt::img::TCamera (docs/spec.md section 2). Loaded from MRPT's
  * `[CAMERA_PARAMS]` ini (the output of camera-calib) or from ROS/OpenCV
  * calibration YAML.
  *

@@ -1,6 +1,6 @@
 #pragma once
 /** \file codebook.h
- * The 3x3 code board (landmark-spec.md section 1): the centre cell is always
+ * The 3x3 code board (docs/spec.md section 1): the centre cell is always
  * black; the other eight cells, read row by row from the top-left as seen
  * from the front and skipping the centre, are bits 7..0 (black = 1).
  */

@@ -1,6 +1,6 @@
 #pragma once
 /** \file detection.h
- * Plain data that crosses libraries (ARCHITECTURE.md): what the detector
+ * Plain data that crosses libraries (docs/design.md, "Libraries"): what the detector
  * reports for one landmark. Defined here so the MRPT plugin can carry it
  * without depending on the detector.
  */

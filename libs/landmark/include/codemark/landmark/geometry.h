@@ -1,6 +1,6 @@
 #pragma once
 /** \file geometry.h
- * The printed landmark of the spec (landmark-spec.md section 1) and its
+ * The printed landmark of the spec (docs/spec.md section 1) and its
  * frame L (section 2): origin at the centre of the green square, X_L the
  * outward normal, Z_L up, Y_L = Z_L x X_L (to the right of an observer who
  * faces the landmark).

@@ -1,6 +1,6 @@
 #pragma once
 /** \file map.h
- * The landmark map file (landmark-spec.md section 3): one landmark per line,
+ * The landmark map file (docs/spec.md section 3): one landmark per line,
  * `id x[m] y[m] z[m] yaw[deg] [scale]`, `#` starts a comment. yaw is the
  * direction of X_L (the outward normal) in the world frame.
  */

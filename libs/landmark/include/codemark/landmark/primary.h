@@ -1,6 +1,6 @@
 #pragma once
 /** \file primary.h
- * The primary measurement P = [x1 y1 x2 y2] (landmark-spec.md section 4):
+ * The primary measurement P = [x1 y1 x2 y2] (docs/spec.md section 4):
  * x1, x2 the image x-coordinates of the midpoints of the left and right
  * inner vertical frame edges, y1, y2 the half-lengths of those edges, from
  * the undistorted corners, in pixels of the single focal length

@@ -3,7 +3,7 @@
  * The landmark measurement L = [l2 phi1 phi2] and the camera's planar pose
  * in the landmark frame, computed directly from scene geometry (not from the
  * image): the ground truth that the closed form of the pose library must
- * reproduce (landmark-spec.md section 4).
+ * reproduce (docs/spec.md section 4).
  */
 #include <mrpt/poses/CPose3D.h>
 

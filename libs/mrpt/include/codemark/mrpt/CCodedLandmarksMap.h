@@ -10,7 +10,7 @@
  *     [MetricMap]
  *     codedLandmarksMap_count = 1
  *     [MetricMap_codedLandmarksMap_00_creationOpts]
- *     map_file = map.txt            // landmark-spec.md section 3
+ *     map_file = map.txt            // docs/spec.md section 3
  *     [MetricMap_codedLandmarksMap_00_likelihoodOpts]
  *     outlier_probability = 0.05
  */

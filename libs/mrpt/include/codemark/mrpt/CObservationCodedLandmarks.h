@@ -20,7 +20,7 @@
 namespace codemark
 {
 /** A landmark observation (sensor label by convention `<CAM>_LANDMARKS`,
- * landmark-spec.md section 6), with the timestamp and camera pose of the
+ * docs/spec.md section 6), with the timestamp and camera pose of the
  * image it was detected in. */
 class CObservationCodedLandmarks : public mrpt::obs::CObservation
 {
@@ -39,7 +39,7 @@ class CObservationCodedLandmarks : public mrpt::obs::CObservation
 		Eigen::Vector4d P = Eigen::Vector4d::Zero();  //!< [x1 y1 x2 y2] [px]
 		Eigen::Matrix4d C_P = Eigen::Matrix4d::Zero();	//!< covariance of P [px^2]
 		/** [l2 phi1 phi2]: horizontal range [m], bearing [rad], relative
-		 * orientation [rad] (landmark-spec.md section 4). */
+		 * orientation [rad] (docs/spec.md section 4). */
 		Eigen::Vector3d L = Eigen::Vector3d::Zero();
 		Eigen::Matrix3d C_L = Eigen::Matrix3d::Zero();	//!< covariance of L
 		/** Camera's planar pose in the landmark frame: x, y [m], theta [rad]. */

@@ -2,7 +2,7 @@
 /** \file pipeline.h
  * One camera image to one landmark observation: detect (libs/detect), then
  * measure each landmark (libs/pose), then wrap the result as the MRPT
- * observation of the plugin (libs/mrpt). ARCHITECTURE.md's flow of an image.
+ * observation of the plugin (libs/mrpt). The flow of an image of docs/design.md.
  */
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/camera.h>
@@ -101,7 +101,7 @@ cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img, const std::string& i
 /** `<dir>/<name without extension>_Images` for a rawlog path: MRPT's
  * external-image folder. Computed here because MRPT 2.5.8's
  * CRawlog::detectImagesDirectory drops the slash for paths with a
- * directory part (mrpt-notes.md). */
+ * directory part (MRPT 2.5.8). */
 std::string imagesDirectoryOf(const std::string& rawlog_path);
 
 }  // namespace codemark::pipeline

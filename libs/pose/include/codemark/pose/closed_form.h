@@ -1,7 +1,7 @@
 #pragma once
 /** \file closed_form.h
  * The paper's closed form (Baczyk, Kasinski, Skrzypczynski 2003, section 2.3
- * and 3) in the conventions of landmark-spec.md section 4:
+ * and 3) in the conventions of docs/spec.md section 4:
  * P = [x1 y1 x2 y2] -> L = [l2 phi1 phi2] -> the camera's planar pose in the
  * landmark frame, with analytic Jacobians, covariance propagation and the
  * composition with the landmark's map pose and the camera's mounting on the
@@ -16,7 +16,7 @@
 namespace codemark::pose
 {
 /** L = [l2 phi1 phi2] from P = [x1 y1 x2 y2] (paper eq. 1-3, the spec's
- * signs; paper-notes.md "Pose"):
+ * signs; docs/design.md, "The measurement"):
  *   xm   = (x1 y2 + x2 y1) / (y1 + y2)
  *   l2   = h (y1 + y2) / (2 y1 y2) * sqrt(lambda^2 + xm^2)
  *   phi1 = -atan2(xm, lambda)

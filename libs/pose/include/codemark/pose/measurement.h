@@ -1,7 +1,7 @@
 #pragma once
 /** \file measurement.h
- * The measurement of one sighted landmark (ARCHITECTURE.md: "Measurement
- * {P, C_P, L, C_L, pose_in_landmark, C_R, method}"; landmark-spec.md
+ * The measurement of one sighted landmark (docs/design.md: "Measurement
+ * {P, C_P, L, C_L, pose_in_landmark, C_R, method}"; docs/spec.md
  * section 4), its options, and measure(), the single entry point that runs
  * either the paper's closed form or the general 6-DoF path.
  */
@@ -280,7 +280,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };
 
-/** One landmark measurement (landmark-spec.md section 4). */
+/** One landmark measurement (docs/spec.md section 4). */
 struct Measurement
 {
 	/** P = [x1 y1 x2 y2]: midpoints' x and half-lengths of the left and right

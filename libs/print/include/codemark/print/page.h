@@ -1,7 +1,7 @@
 #pragma once
 /** \file page.h
  * The printable page of one or several landmarks as plain drawing data in
- * millimetres (landmark-spec.md section 1): filled rectangles and text lines
+ * millimetres (docs/spec.md section 1): filled rectangles and text lines
  * on a white page, origin at the page's top-left corner, x right, y down
  * (the SVG and PDF page convention). The writers of output.h turn a Page into
  * SVG, PNG or PDF at exact physical size.
