@@ -8,8 +8,13 @@ Each table in README.md sits between two markers:
     <!-- end report -->
 
 `table N` is the N-th table of the report (1-based; a table is a run of
-lines that start with '|'), `columns` keeps those columns (1-based, the
-first one always), `rows` keeps the header and the rows that contain TEXT.
+lines that start with '|'), `columns` keeps those columns (1-based), `rows`
+keeps the header and the rows that contain TEXT. A source file is copied
+the same way, as a fenced block:
+
+    <!-- file examples/quickstart.cpp -->
+    <!-- end file -->
+
 Without arguments the script rewrites README.md; with --check it exits 1
 and prints the difference when README.md does not match the reports (the
 test suite runs it so).
@@ -23,6 +28,8 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 MARKER = re.compile(
     r"^<!-- report (\S+) table (\d+)(?: columns ([\d,]+))?(?: rows (.+?))? -->$")
 END = "<!-- end report -->"
+FILE = re.compile(r"^<!-- file (\S+) -->$")
+END_FILE = "<!-- end file -->"
 
 
 def tables(path):
@@ -64,8 +71,20 @@ def render(readme):
     out, i = [], 0
     while i < len(lines):
         m = MARKER.match(lines[i])
+        f = FILE.match(lines[i])
         out.append(lines[i])
         i += 1
+        if f:
+            end = i
+            while end < len(lines) and lines[end] != END_FILE:
+                end += 1
+            if end == len(lines):
+                sys.exit(f"README.md:{i}: no '{END_FILE}' after the marker")
+            lang = "cpp" if f.group(1).endswith((".cpp", ".h")) else ""
+            out += ["```" + lang] + (ROOT / f.group(1)).read_text().rstrip("\n").split("\n")
+            out += ["```", END_FILE]
+            i = end + 1
+            continue
         if not m:
             continue
         where = f"README.md:{i}"
