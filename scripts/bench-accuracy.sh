@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds and runs the pose benchmarks (issue 4): the calibration of C_P
+# Builds and runs the pose benchmarks: the calibration of C_P
 # (codemark-bench-pose-calib, the data behind the shipped calibrations
 # share/codemark/calibration/*.ini) and the accuracy map
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,

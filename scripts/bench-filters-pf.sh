@@ -2,7 +2,7 @@
 # Builds and runs the particle-filter benchmark (bench/filters_pf): time per
 # update against the number of particles (10^2..10^5) with our
 # CCodedLandmarksMap and with a constant-likelihood map in the same run (the
-# ratio is issue 6's "at most 1.5x MRPT's own overhead" target), and frames
+# ratio's target is "at most 1.5x MRPT's own overhead"), and frames
 # with sightings to convergence from a uniform start (shipped pf.ini, 10
 # seeds). Prints the markdown tables; docs/benchmarks/filters-pf.md quotes
 # them. About 1 minute on 2 cores.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Benchmarks of the filters (issue 6), written to docs/benchmarks/filters.md.
+# Benchmarks of the filters, written to docs/benchmarks/filters.md.
 # Modular: one function per section, each appending its Markdown to the doc,
-# so that sections can be added (e.g. the EKF-SLAM engineer's kf-slam_demo
+# so that sections can be added (e.g. the EKF-SLAM kf-slam_demo
 # section) without touching the others. Run all sections, or name them:
 #   scripts/bench-filters.sh            # every section
 #   scripts/bench-filters.sh sim        # only the simulated-data section
@@ -53,7 +53,7 @@ Notes on the simulated section:
   (`[stepper] max_view_angle_deg`: the range is biased short beyond the
   detector's validated range). The EKF ("ekf") uses the iterated update
   (`[ekf] iterations = 10`). ekf-slam runs with the true map as its prior.
-- Issue 6's targets on the default renders (noise 2, blur 0.8 px): EKF
+- The targets on the default renders (noise 2, blur 0.8 px): EKF
   ATE <= 3 cm over the seeds, the runs' mean NEES averaged over the seeds
   inside the 95% band of one run, first fix at the first frame;
   tests/filters/test_sim.cpp checks the same on the same seeds. The largest
@@ -84,8 +84,8 @@ NOTES
 	} >>"$DOC"
 }
 
-# --- section: MRPT's kf-slam_demo (our EKF-SLAM vs stock kf-slam), by the
-# EKF-SLAM engineer's scripts/bench-filters-slam.sh (its own doc,
+# --- section: MRPT's kf-slam_demo (our EKF-SLAM vs stock kf-slam), by
+# scripts/bench-filters-slam.sh (its own doc,
 # docs/benchmarks/filters-slam.md), copied in here below a heading.
 section_kfslam()
 {

@@ -759,7 +759,7 @@ std::string writeResults(
 			  << fmt(chi2Quantile(0.025, 3.0 * d0) / d0, 3) << ", "
 			  << fmt(chi2Quantile(0.975, 3.0 * d0) / d0, 3) << "]\n";
 	}
-	// Issue 4: at every distance and angle no worse than AprilTag on the
+	// The target: at every distance and angle no worse than AprilTag on the
 	// same metrics. A cell's mean over a few renders is noisy (10 renders:
 	// about 25% of the error), so "worse" counts twice and the excess is
 	// set against the standard error of the difference of the two means.
@@ -807,7 +807,7 @@ std::string writeResults(
 	}
 	s << "\n# paper (real images, 1 px sigma): about 50 mm in x and y and < 2 deg within 2 m in "
 		 "front\n"
-		 "# issue 4 targets (within 2 m): range <= 0.05%, bearing <= 0.005 deg, phi2 <= 0.4 deg, "
+		 "# targets (within 2 m): range <= 0.05%, bearing <= 0.005 deg, phi2 <= 0.4 deg, "
 		 "position <= 10 mm;"
 		 " 2-5 m: range <= 0.15%, bearing <= 0.005 deg, phi2 <= 2 deg; NEES in the 95% band\n";
 	const std::string text = s.str();

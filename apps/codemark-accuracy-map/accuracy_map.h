@@ -121,7 +121,7 @@ std::vector<CellResult> runSurvey(
 /** Writes cells.csv, heat maps (heat_l2.png, heat_phi2.png, heat_x.png,
  * heat_y.png: measured mean absolute error beside the predicted sigma) and
  * summary.txt into \a dir (created when missing); returns the summary text
- * (the table against the paper's claims and the issue's targets). */
+ * (the table against the paper's claims and the targets). */
 std::string writeResults(
 	const std::vector<CellResult>& cells, const SurveyOptions& options, const std::string& dir);
 

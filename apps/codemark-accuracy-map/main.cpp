@@ -1,5 +1,5 @@
 /** \file main.cpp
- * codemark-accuracy-map: the paper's Figs. 5-8 on renders (issue 4). Parses
+ * codemark-accuracy-map: the paper's Figs. 5-8 on renders. Parses
  * the command line and calls the survey in accuracy_map.h.
  */
 #include <tclap/CmdLine.h>

@@ -5,7 +5,7 @@
  * itself (RPE, aligned ATE, detection rate against the ground truth), and
  * the report (CSV, Markdown, plots). App-internal: the per-job loop mirrors
  * filters::runLocalization() with per-frame detection bookkeeping added, so
- * that libs/ stays untouched (see the report of issue #7).
+ * that libs/ stays untouched.
  */
 #include <codemark/filters/outputs.h>
 

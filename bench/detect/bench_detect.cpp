@@ -1,5 +1,5 @@
 /** \file bench_detect.cpp
- * codemark-bench-detect: the detection benchmark of issue 3. One run renders
+ * codemark-bench-detect: the detection benchmark. One run renders
  * a shared set of scenes (same camera, poses, backgrounds, blur and noise)
  * with our landmark, an ArUco DICT_4X4_50 marker and an AprilTag tag36h11
  * tag, each with a 160 mm reference square, and measures codemark, OpenCV
@@ -588,7 +588,7 @@ int runBench(const Config& cfg)
 					sweep[k][di][ai].add(s);
 					if (k == 0 && s.truths && !s.detected && !cfg.dump_dir.empty())
 					{
-						// The frame and its true corners, for the detector's engineer.
+						// The frame and its true corners, for debugging the detector.
 						const std::string base = cfg.dump_dir + "/miss-" + fmt(distances[di], 2) +
 												 "m-" + fmt(a * 180 / CV_PI, 0) + "deg-seed" +
 												 std::to_string(frame_seed);
@@ -994,7 +994,7 @@ int runBench(const Config& cfg)
 			err_ok = false;
 	}
 	const auto verdict = [](bool ok) { return ok ? "met" : "**missed**"; };
-	md << "## Targets (issue 3)\n\n| target | measured | |\n|---|---|---|\n"
+	md << "## Targets\n\n| target | measured | |\n|---|---|---|\n"
 	   << "| one landmark: codemark <= 0.1x ArUco | " << fmt(med[0] / med[1], 3) << "x | "
 	   << verdict(med[0] <= 0.1 * med[1]) << " |\n"
 	   << "| one landmark: codemark <= 0.1x AprilTag d2 | " << fmt(med[0] / med[3], 3) << "x | "
@@ -1086,8 +1086,7 @@ int main(int argc, char** argv)
 	{
 		TCLAP::CmdLine cmd(
 			"Detection benchmark: codemark vs OpenCV ArUco and AprilTag 3 on the same rendered "
-			"scenes "
-			"(issue 3). Prints a Markdown report.",
+			"scenes. Prints a Markdown report.",
 			' ', "0.1");
 		TCLAP::SwitchArg quick("", "quick", "smoke run with small samples (< 1 min)", cmd);
 		TCLAP::ValueArg<std::string> out(

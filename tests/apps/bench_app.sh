@@ -31,7 +31,7 @@ test -s "$tmp/out2/images/ekf/estimated_path.txt" && test -s "$tmp/out2/annotate
 grep -q "images-error.png" "$tmp/out2/report.md"
 
 # Bounds, physically motivated:
-#  - ATE < 0.10 m: issue #6's criterion of a converged filter (position error < 10 cm);
+#  - ATE < 0.10 m: the criterion of a converged filter (position error < 10 cm);
 #    the landmarks are 1.2 m or more away and measured to a few mm and tenths of a degree.
 #  - detection rate > 0.9 and no wrong ID: the detector's benchmark measured 98.8% where the
 #    square spans >= 30 px (the bench's in-view criterion) and 0 wrong IDs on 1000 clutter frames.

@@ -16,7 +16,7 @@ namespace codemark::detect::test
 {
 constexpr double kDeg = M_PI / 180;
 
-/** The nominal conditions of issue 3 that a range varies one at a time. */
+/** The nominal conditions that a range varies one at a time. */
 inline sim::RenderOptions nominalRender()
 {
 	sim::RenderOptions o;

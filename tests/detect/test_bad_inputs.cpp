@@ -1,4 +1,4 @@
-// Bad inputs (issue 7's sweep, for the detector): the entry point gives a
+// Bad inputs (the bad-input sweep, for the detector): the entry point gives a
 // clear error or nothing, never a crash or a hang; codemark-detect prints one
 // JSON error line per bad input and exits non-zero at the end.
 #include <codemark/detect/detector.h>

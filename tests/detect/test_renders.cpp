@@ -1,6 +1,6 @@
 // The detector on renders of codemark::sim with exact ground truth: every
 // landmark found with the right ID and corners within 0.3 px over the
-// ranges of issue 3, exhaustive decoding, flipped cells, negatives.
+// target ranges, exhaustive decoding, flipped cells, negatives.
 #include "common.h"
 #include "stages.h"
 
@@ -310,8 +310,8 @@ TEST(Renders, Combination5mAt60Deg)
 
 // 5 m at 60 deg, more renders and IDs: the green band between the inner
 // edge and the code board is then 2.8 px wide, and the code cells next to
-// it are black for some IDs (the fill test used to look 3 px deep and
-// miss 5 of these 40). Every one found with its ID; the corners' mean error
+// it are black for some IDs (a fill test that looks 3 px deep misses
+// 5 of these 40). Every one found with its ID; the corners' mean error
 // stays at the benchmark's level (single corners reach 0.4-0.5 px here).
 TEST(Renders, Combination5mAt60DegEveryIdFound)
 {

@@ -725,7 +725,7 @@ std::vector<int> thinFrameProfile(double x0, double width, double sigma, double 
 // The frame's outer edge 1.6-3.2 px away pulls the inner edge's derivative
 // peak inwards; the lobe model removes most of that pull, also when the
 // lobe makes the peak's outer neighbour sample negative (a bright wall: the
-// log-parabola then has no width of its own, and the model used to be
+// log-parabola then has no width of its own, and the model must not be
 // skipped). Largest error over sub-pixel positions, with and without it.
 TEST(Subpixel, PeakModeRemovesMostOfTheOuterEdgeOfAThinFrame)
 {

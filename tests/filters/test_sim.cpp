@@ -58,7 +58,7 @@ void expectCommon(const LocalizeSummary& s)
 	print(s);
 }
 
-/** Issue 6's simulated-data targets for \a method over the seeds of the
+/** The simulated-data targets for \a method over the seeds of the
  * filters benchmark (bench/filters_sim: seeds 1-3 of codemark-simul's room
  * loop, 5 Hz images, 3% odometry scale error, global initialisation): mean
  * ATE <= \a max_ate_m, and the runs' mean NEES, averaged over the seeds,
@@ -93,7 +93,7 @@ void expectTargetsOverSeeds(
 }
 }  // namespace
 
-// Issue 6's target on the benchmark's datasets: EKF ATE <= 3 cm, mean NEES
+// The target on the benchmark's datasets: EKF ATE <= 3 cm, mean NEES
 // inside the 95% band, first fix at the first sighting.
 TEST(FiltersSim, EkfMeetsTheTargetsOnTheBenchmarkLoops)
 {
@@ -115,7 +115,7 @@ TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 	// each with MRPT's floors (minStdXY 1 cm, minStdPHI 0.2 deg): about twice
 	// the odometry noise of the actions-observations loops of the same seeds,
 	// hence a larger error (ATE 3.8 cm against 2.7 cm on seed 3). This checks
-	// the interpolation; FiltersSim.EkfMeetsTheTargets... checks the issue's
+	// the interpolation; FiltersSim.EkfMeetsTheTargets... checks the
 	// targets. Over the same three seeds: one loop's 118 poses are strongly
 	// correlated in time, so one loop's mean NEES strays from the band more
 	// often than the band's 5% (seed 3 alone: 3.92 against [2.57, 3.46]).
@@ -124,7 +124,7 @@ TEST(FiltersSim, EkfObservationsOnlyWithInterpolatedOdometry)
 
 // EKF-SLAM from scratch (no map) on the rendered loop: almost nothing gated,
 // landmark yaws and positions close to the truth after the SE(2) alignment
-// (they used to drift by hundreds of degrees with most sightings gated).
+// (a failing filter drifts by hundreds of degrees with most sightings gated).
 TEST(FiltersSim, EkfSlamMapsTheRoomWithSmallLandmarkYawErrors)
 {
 	const LocalizeSummary s = runOn(false, 0, "ekf-slam", "ekf-slam.ini", true);

@@ -251,7 +251,7 @@ TEST(Stepper, AnnotatedImagesAreNotDetectedAgainButBareOnesAre)
 // Each stepper loads its own rawlog's external images, also while another
 // stepper reads another rawlog (codemark-bench runs datasets in parallel):
 // MRPT's images folder is process-wide, and the second stepper's rawlog
-// used to redirect the first one's relative file names to its own folder.
+// must not redirect the first one's relative file names to its own folder.
 TEST(Stepper, ExternalImagesComeFromTheirOwnRawlogsFolder)
 {
 	const auto dir = std::filesystem::path(tempFile("two_rawlogs"));
@@ -436,6 +436,9 @@ TEST(Stepper, RemeasuresAnnotatedSightingsUnderThePipelinesCalibration)
 		const Eigen::Matrix3d want = remeasure ? expected.C_L : lm->sightings[0].C_L;
 		EXPECT_LT((t.C_L - want).norm(), 1e-12 * want.norm()) << remeasure;
 		EXPECT_LT((t.L - expected.L).norm(), 1e-6);
-		if (remeasure) EXPECT_NEAR(t.C_P(0, 0), 0.04, 1e-12);
+		if (remeasure)
+		{
+			EXPECT_NEAR(t.C_P(0, 0), 0.04, 1e-12);
+		}
 	}
 }

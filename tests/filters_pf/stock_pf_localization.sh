@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 6 item 8: MRPT's stock pf-localization, with LD_PRELOAD of the plugin
+# MRPT's stock pf-localization, with LD_PRELOAD of the plugin
 # and share/codemark/pf-localization.ini declaring our map, localizes on a
 # simulated rawlog annotated with our observations.
 #   stock_pf_localization.sh MODE SIMUL ANNOTATE PLUGIN INI WORKDIR [TRUTH_ANNOTATE]

@@ -296,7 +296,7 @@ TEST(ParticleFilter, ConvergesFromAUniformStart)
 		EXPECT_FALSE(f->estimate().initialized);
 		std::mt19937 rng(seed);
 		const RunResult r = runCircle(*f, 0, 60, rng);
-		// Issue 6 target: converged (< 10 cm) within 3 sightings.
+		// The target: converged (< 10 cm) within 3 sightings.
 		EXPECT_GE(r.frames_with_sightings_to_converge, 1) << "seed " << seed;
 		EXPECT_LE(r.frames_with_sightings_to_converge, 3) << "seed " << seed;
 		EXPECT_LT(r.final_error_m, 0.10) << "seed " << seed;

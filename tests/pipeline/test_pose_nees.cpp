@@ -7,8 +7,8 @@
 // beyond it the vertical frames are 1-2 px, the range is biased short and
 // C_P does not hold), the mean NEES of the camera's pose in the landmark frame
 // must lie in the 95% chi-square band, for both pose paths, over the
-// sightings whose predicted phi2 sigma is at most 2 deg (the accuracy the
-// issue asks of phi2; beyond it x, y = l2 (cos, sin)(phi1 + phi2) are too
+// sightings whose predicted phi2 sigma is at most 2 deg (the accuracy
+// targeted for phi2; beyond it x, y = l2 (cos, sin)(phi1 + phi2) are too
 // curved over the phi2 uncertainty for a Gaussian C_R, even to second
 // order, and accuracy-map's summary shows how the NEES grows there). At
 // least 200 such sightings are required.

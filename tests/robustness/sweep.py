@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Bad-input sweep (issue #7 item 3): every app on missing, empty, truncated,
+"""Bad-input sweep: every app on missing, empty, truncated,
 bit-flipped and malformed inputs. Python standard library only.
 
   sweep.py list                      the case names, one per line (for CMake)

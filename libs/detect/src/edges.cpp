@@ -201,7 +201,7 @@ std::optional<SideSegments> selectSegments(
 		// The domain's position is known to half a pixel of its gradient
 		// image. A grid cell and more inwards, but within the green band
 		// before the code board (2.8 px wide at 5 m and 60 deg, where a
-		// black code cell 3 px inwards used to hide the fill).
+		// black code cell 3 px inwards would hide the fill).
 		const double reach = std::min(std::max(2.0, step + 1.0), std::max(1.5, 0.6 * band_px)) +
 							 0.5 * (d.pixel_px - 1);
 		for (const double t : {-0.25, 0.0, 0.25})

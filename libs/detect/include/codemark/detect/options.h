@@ -3,7 +3,7 @@
  * Parameters of the landmark detector (docs/design.md, "The detector"),
  * one small block per stage, loadable from an MRPT ini section
  * (share/codemark/detector.ini). Every default works, untouched, over the
- * ranges of issue 3 (0.5-5 m, 0-60 deg, gain 0.3-2, noise <= 5, blur <= 1.5,
+ * target ranges (0.5-5 m, 0-60 deg, gain 0.3-2, noise <= 5, blur <= 1.5,
  * JPEG >= 70) for the 640x480, fx = 800 camera of the paper.
  */
 #include <mrpt/config/CLoadableOptions.h>

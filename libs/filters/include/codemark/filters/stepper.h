@@ -43,7 +43,7 @@ struct StepperOptions : public mrpt::config::CLoadableOptions
 	/** Coded sightings seen more obliquely than this are dropped before any
 	 * filter sees them [deg]: the angle between the line of sight and the
 	 * landmark's normal, |phi1 + phi2| (docs/spec.md section 4). The
-	 * detector and the closed form are validated up to 60 deg (issue #3's
+	 * detector and the closed form are validated up to 60 deg (the
 	 * render tests); beyond it the measured range is biased short (2-3 cm,
 	 * 2 sigma, at 73 deg and 4 m in codemark-simul's default room), a
 	 * systematic error that C_L does not describe and that made the filters
