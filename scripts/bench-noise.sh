@@ -65,8 +65,12 @@ awk -v f="$START_DIVISOR" '
 		print line; next }
 	{ print }' "$share/calibration/family.ini" >"$start"
 
-# summary.json's value of KEY.
-json() { sed -n "s/^  \"$2\": \(.*\),\{0,1\}$/\1/p" "$1" | sed 's/,$//; s/^"//; s/"$//'; }
+# summary.json's value of KEY (a list's items joined by ", ").
+json() {
+	python3 -c 'import json, sys
+v = json.load(open(sys.argv[1])).get(sys.argv[2])
+print(", ".join(map(str, v)) if isinstance(v, list) else ("" if v is None else v))' "$1" "$2"
+}
 
 rows=()
 fit_rows=()
@@ -103,7 +107,7 @@ run_set() { # name renderer preset
 					--method "$method" -r "$dir/run$seed/dataset.rawlog" -m "$dir/run$seed/map.txt" \
 					-g "$dir/run$seed/gt_path.txt" --calibration "$c" -o "$out" >/dev/null
 				local s="$out/summary.json" band
-				band=$(sed -n 's/^  "nees_band_95": \[\(.*\)\],$/\1/p' "$s")
+				band=$(json "$s" nees_band_95)
 				rows+=("| $name | $seed | $cal | $method | $(awk -v a="$(json "$s" ate_rmse_m)" 'BEGIN{printf "%.2f", 100*a}') | $(awk -v a="$(json "$s" nees_mean)" 'BEGIN{printf "%.2f", a}') [${band/, /, }] | $(awk -v a="$(json "$s" nis_mean)" -v d="$(json "$s" nis_dof)" 'BEGIN{printf "%.2f", a/d}') | $(awk -v a="$(json "$s" nis_visit_ratio)" 'BEGIN{printf "%.2f", a}') | $(json "$s" nis_verdict) | $(awk -v a="$(json "$s" gated_fraction)" 'BEGIN{printf "%.1f", 100*a}') |")
 			done
 		done

@@ -9,7 +9,7 @@ PACKAGES=(
   libmrpt-dev mrpt-apps mrpt-common
   libopencv-dev libopencv-contrib-dev
   libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
-  libapriltag-dev libcairo2-dev libtclap-dev
+  libapriltag-dev libcairo2-dev libtclap-dev nlohmann-json3-dev
   xvfb xdotool imagemagick
   povray
   python3 clang-14 libclang-rt-14-dev clang-tidy-14 clang-format-14 clang-tools-14

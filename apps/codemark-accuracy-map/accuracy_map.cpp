@@ -1,5 +1,6 @@
 #include "accuracy_map.h"
 
+#include <mrpt/math/distributions.h>
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/pose/closed_form.h>
@@ -470,16 +471,8 @@ void heatMap(
 	if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
 }
 
-// Chi-square quantile (Wilson-Hilferty approximation; accurate to <1% for
-// the hundreds of degrees of freedom used here).
-double chi2Quantile(double p, double k)
-{
-	// Standard normal quantile (Acklam's rational approximation would be
-	// overkill: only 0.025 and 0.975 are needed).
-	const double z = p < 0.5 ? -1.959963984540054 : 1.959963984540054;
-	const double h = 2.0 / (9 * k);
-	return k * std::pow(1 - h + z * std::sqrt(h), 3);
-}
+// Chi-square quantile of probability p with k degrees of freedom.
+double chi2Quantile(double p, double k) { return mrpt::math::chi2inv(p, static_cast<unsigned>(k)); }
 }  // namespace
 
 std::string writeResults(

@@ -76,10 +76,9 @@ std::string jsonMatrix(const Eigen::Matrix3d& m)
 struct Runner
 {
 	CameraModel camera;
-	LandmarkGeometry geometry;
-	detect::DetectorOptions options;
-	/** Pose options: the pipeline's, calibrated for this detector. */
-	pose::PoseOptions pose = pipeline::calibratedPoseOptions();
+	/** The detector's, the pose library's options (the default calibration
+	 * unless told otherwise), the landmark and the map's per-ID sizes. */
+	pipeline::PipelineOptions pipe;
 	std::string draw_dir, debug_dir;
 	bool colour_report = false;
 	int failures = 0;
@@ -87,7 +86,7 @@ struct Runner
 	/** The colour report's readable table of one detection, on stderr. */
 	void printColourTable(const std::string& name, int id, const detect::ColourReport& c) const
 	{
-		const auto& s = options.segmentation;
+		const auto& s = pipe.detector.segmentation;
 		char buf[512];
 		std::cerr << "codemark-detect: colours of landmark " << id << " in " << name << "\n";
 		std::cerr << "            R      G      B   hue[deg]  sat      I\n";
@@ -116,8 +115,9 @@ struct Runner
 		row("hue min", c.margin_hue_min_deg, "fill hue >= %g deg", s.hue_min_deg);
 		row("hue max", c.margin_hue_max_deg, "fill hue <= %g deg", s.hue_max_deg);
 		row("black ratio", c.margin_black_ratio, "frame G / fill G <= %g",
-			options.code.max_black_ratio);
-		row("contrast", c.margin_contrast, "fill G - frame G >= %g", options.code.min_contrast);
+			pipe.detector.code.max_black_ratio);
+		row("contrast", c.margin_contrast, "fill G - frame G >= %g",
+			pipe.detector.code.min_contrast);
 	}
 
 	void fail(const std::string& name, const std::string& why)
@@ -152,10 +152,10 @@ struct Runner
 			dbg = (fs::path(debug_dir) / flatName(name)).string();
 			fs::create_directories(dbg);
 		}
-		detect::DetectionResult res;
+		pipeline::ImageResult res;
 		try
 		{
-			res = detect::detect(img, camera, geometry, options, dbg);
+			res = pipeline::processImage(img, camera, pipe, dbg);
 		}
 		catch (const std::exception& e)
 		{
@@ -164,46 +164,49 @@ struct Runner
 			fail(name, std::string("detection failed: ") + e.what());
 			return;
 		}
-		// L, C_L, pose_in_landmark and C_R of each detection (spec section 5).
+		// Each measured detection with L, C_L, pose_in_landmark and C_R
+		// (spec section 5), then those whose corners gave no measurement.
+		std::vector<detect::DetectedLandmark> dets;
 		std::vector<detect::JsonFields> extra;
-		for (const auto& d : res.landmarks)
+		for (const auto& lm : res.landmarks)
 		{
+			const auto& d = lm.detected;
+			const auto& m = lm.measurement;
 			detect::JsonFields f;
-			try
+			f.emplace_back("L", jsonVector(m.L));
+			f.emplace_back("C_L", jsonMatrix(m.C_L));
+			f.emplace_back("pose_in_landmark", jsonVector(m.pose_in_landmark));
+			f.emplace_back("C_R", jsonMatrix(m.C_R));
+			// The mirror-image optimum folded into C_L and C_R (PoseOptions::
+			// fold_ambiguity), when there is one: its probability and L.
+			if (m.second_mode_weight > 0)
 			{
-				const auto m = pose::measure(d.detection, camera, geometry, pose);
-				f.emplace_back("L", jsonVector(m.L));
-				f.emplace_back("C_L", jsonMatrix(m.C_L));
-				f.emplace_back("pose_in_landmark", jsonVector(m.pose_in_landmark));
-				f.emplace_back("C_R", jsonMatrix(m.C_R));
-				// The mirror-image optimum folded into C_L and C_R (PoseOptions::
-				// fold_ambiguity), when there is one: its probability and L.
-				if (m.second_mode_weight > 0)
-				{
-					f.emplace_back("second_mode_weight", detect::jsonNumber(m.second_mode_weight));
-					f.emplace_back("second_mode_L", jsonVector(m.second_mode_L));
-				}
-			}
-			catch (const std::invalid_argument&)
-			{
-				// Degenerate corners: the detection without a measurement.
+				f.emplace_back("second_mode_weight", detect::jsonNumber(m.second_mode_weight));
+				f.emplace_back("second_mode_L", jsonVector(m.second_mode_L));
 			}
 			if (colour_report)
 			{
-				const auto c = detect::colourReport(img, d.detection, camera, geometry, options);
+				const auto c = detect::colourReport(
+					img, d.detection, camera, pipeline::geometryFor(d.detection.id, pipe),
+					pipe.detector);
 				f.emplace_back("fill_colour", detect::colourReportJson(c));
 				printColourTable(name, d.detection.id, c);
 			}
+			dets.push_back(d);
 			extra.push_back(std::move(f));
 		}
+		for (const auto& d : res.unmeasured)
+		{
+			dets.push_back(d);
+			extra.emplace_back();
+		}
 		std::cout << detect::imageToJson(
-						 name, img.cols, img.rows, res.timings.total_us / 1000.0, res.landmarks,
-						 extra)
+						 name, img.cols, img.rows, res.timings.total_us / 1000.0, dets, extra)
 				  << std::endl;
 		if (!draw_dir.empty())
 		{
 			cv::Mat ov = img.clone();
-			detect::drawDetections(ov, res.landmarks);
+			detect::drawDetections(ov, dets);
 			const std::string out = (fs::path(draw_dir) / (flatName(name) + ".png")).string();
 			if (!cv::imwrite(out, ov)) std::cerr << "warning: cannot write " << out << "\n";
 		}
@@ -323,6 +326,11 @@ int main(int argc, char** argv)
 			"--calibration's). Default: the built-in defaults.",
 			false, "", "detector.ini", cmd);
 		auto calibration_arg = app::calibrationArg(cmd);
+		TCLAP::ValueArg<std::string> map_arg(
+			"", "map",
+			"landmark map (docs/spec.md section 3): each ID in it is measured at its printed "
+			"scale; other IDs at the landmark file's size",
+			false, "", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> draw_arg(
 			"", "draw",
 			"Folder (created when missing) that receives one overlay PNG per image: the "
@@ -368,19 +376,20 @@ int main(int argc, char** argv)
 				throw std::runtime_error(path + ": no [LANDMARK] section");
 			try
 			{
-				r.geometry.loadFromConfigFile(cfg, "LANDMARK");
+				r.pipe.geometry.loadFromConfigFile(cfg, "LANDMARK");
 			}
 			catch (const std::exception& e)
 			{
 				throw std::runtime_error(path + ": " + e.what());
 			}
 		}
-		r.pose = pipeline::calibratedPoseOptions(calibration_arg.getValue());
+		r.pipe.pose = pipeline::calibratedPoseOptions(calibration_arg.getValue());
+		if (map_arg.isSet()) r.pipe.map = LandmarkMap::load(map_arg.getValue());
 		if (config_arg.isSet())
 		{
-			r.options = detect::DetectorOptions::load(config_arg.getValue());
+			r.pipe.detector = detect::DetectorOptions::load(config_arg.getValue());
 			mrpt::config::CConfigFile cfg(config_arg.getValue());
-			if (cfg.sectionExists("pose")) r.pose.loadFromConfigFile(cfg, "pose");
+			if (cfg.sectionExists("pose")) r.pipe.pose.loadFromConfigFile(cfg, "pose");
 		}
 		r.draw_dir = draw_arg.getValue();
 		r.debug_dir = debug_arg.getValue();
@@ -393,7 +402,7 @@ int main(int argc, char** argv)
 			cv::Mat warm(64, 64, CV_8UC3, cv::Scalar(235, 235, 235));
 			cv::rectangle(warm, cv::Rect(12, 12, 40, 40), cv::Scalar(25, 25, 25), cv::FILLED);
 			cv::rectangle(warm, cv::Rect(16, 16, 32, 32), cv::Scalar(0, 255, 0), cv::FILLED);
-			detect::detect(warm, r.camera, r.geometry, r.options);
+			detect::detect(warm, r.camera, r.pipe.geometry, r.pipe.detector);
 		}
 		for (const auto& in : inputs_arg.getValue()) r.input(in);
 		return r.failures ? 1 : 0;

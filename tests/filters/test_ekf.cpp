@@ -4,6 +4,8 @@
 
 #include "common.h"
 
+#include "../common/numeric_diff.h"
+
 using namespace codemark;
 using namespace codemark::filters;
 using namespace codemark::filters::test;
@@ -47,17 +49,9 @@ TEST(EkfModel, ObservationJacobianMatchesNumeric)
 		const CPose2D lm(6 + u(rng), 2 + u(rng), M_PI + 0.5 * u(rng));
 		Eigen::Matrix3d H;
 		const Eigen::Vector3d h0 = predictLandmarkMeasurement(x, cam, lm, &H);
-		Eigen::Matrix3d Hn;
-		const double eps = 1e-6;
-		for (int j = 0; j < 3; ++j)
-		{
-			Eigen::Vector3d xp = x, xm = x;
-			xp[j] += eps, xm[j] -= eps;
-			Eigen::Vector3d d =
-				predictLandmarkMeasurement(xp, cam, lm) - predictLandmarkMeasurement(xm, cam, lm);
-			d[1] = mrpt::math::wrapToPi(d[1]), d[2] = mrpt::math::wrapToPi(d[2]);
-			Hn.col(j) = d / (2 * eps);
-		}
+		const Eigen::Matrix3d Hn = codemark::test::numericJacobian(
+			[&](const Eigen::Vector3d& v) { return predictLandmarkMeasurement(v, cam, lm); }, x,
+			1e-6, {1, 2});
 		EXPECT_LT((H - Hn).cwiseAbs().maxCoeff(), 1e-6) << "x " << x.transpose() << "\nH\n"
 														<< H << "\nHn\n"
 														<< Hn;
@@ -89,16 +83,12 @@ TEST(EkfModel, MotionJacobiansMatchNumeric)
 	const Eigen::Vector3d x(1, 2, 3.1), u(0.2, -0.05, 0.1);
 	Eigen::Matrix3d F, G;
 	composeMotion(x, u, &F, &G);
-	const double eps = 1e-6;
-	for (int j = 0; j < 3; ++j)
-	{
-		Eigen::Vector3d d = Eigen::Vector3d::Unit(j) * eps;
-		Eigen::Vector3d dfx = composeMotion(x + d, u) - composeMotion(x - d, u);
-		Eigen::Vector3d dfu = composeMotion(x, u + d) - composeMotion(x, u - d);
-		dfx[2] = mrpt::math::wrapToPi(dfx[2]), dfu[2] = mrpt::math::wrapToPi(dfu[2]);
-		EXPECT_LT((F.col(j) - dfx / (2 * eps)).cwiseAbs().maxCoeff(), 1e-6);
-		EXPECT_LT((G.col(j) - dfu / (2 * eps)).cwiseAbs().maxCoeff(), 1e-6);
-	}
+	const Eigen::MatrixXd Fn = codemark::test::numericJacobian(
+		[&](const Eigen::Vector3d& v) { return composeMotion(v, u); }, x, 1e-6, {2});
+	const Eigen::MatrixXd Gn = codemark::test::numericJacobian(
+		[&](const Eigen::Vector3d& v) { return composeMotion(x, v); }, u, 1e-6, {2});
+	EXPECT_LT((F - Fn).cwiseAbs().maxCoeff(), 1e-6);
+	EXPECT_LT((G - Gn).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 TEST(EkfModel, CovarianceCheckSymmetrisesAndRejects)

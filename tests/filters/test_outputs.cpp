@@ -3,6 +3,7 @@
 #include <codemark/filters/ground_truth.h>
 #include <codemark/filters/outputs.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/serialization/CArchive.h>
@@ -179,11 +180,13 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 	EXPECT_NE(line.find(".000000 "), std::string::npos) << line;  // >= 6 decimals
 	std::ifstream js(fs::path(req.out_dir) / "summary.json");
 	const std::string json((std::istreambuf_iterator<char>(js)), {});
+	const auto parsed = nlohmann::json::parse(json);  // valid JSON, or it throws
 	for (const char* k :
-		 {"\"steps\"", "\"sightings_used\"", "\"sightings_rejected\"", "\"sightings_unknown_id\"",
-		  "\"time_per_step_ms\"", "\"ate_rmse_m\"", "\"max_error_m\"", "\"yaw_rmse_deg\"",
-		  "\"nees_mean\""})
-		EXPECT_NE(json.find(k), std::string::npos) << k;
+		 {"steps", "sightings_used", "sightings_rejected", "sightings_unknown_id",
+		  "time_per_step_ms", "ate_rmse_m", "max_error_m", "yaw_rmse_deg", "nees_mean",
+		  "nees_band_95", "nis_mean", "nis_dof", "nis_count", "gated_fraction", "nis_verdict"})
+		EXPECT_TRUE(parsed.contains(k)) << k;
+	EXPECT_EQ(parsed["nees_band_95"].size(), 2u);
 
 	// Bad input: one error naming the file.
 	req.map_file = writeText("badmap.txt", "1 2 3\n");

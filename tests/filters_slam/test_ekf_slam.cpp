@@ -22,6 +22,8 @@
 #include <fstream>
 #include <random>
 
+#include "../common/numeric_diff.h"
+
 using namespace codemark;
 using namespace codemark::filters;
 
@@ -84,15 +86,10 @@ mrpt::obs::CActionRobotMovement2D motion(const mrpt::poses::CPose2D& inc, double
 }
 
 Eigen::Vector3d numericColumn(
-	const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& f, Eigen::Vector3d x, int j)
+	const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& f, const Eigen::Vector3d& x,
+	int j)
 {
-	const double e = 1e-6;
-	Eigen::Vector3d xp = x, xm = x;
-	xp[j] += e;
-	xm[j] -= e;
-	Eigen::Vector3d d = f(xp) - f(xm);
-	for (int k : {1, 2}) d[k] = wrapToPi(d[k]);
-	return d / (2 * e);
+	return codemark::test::numericJacobian(f, x, 1e-6, {1, 2}).col(j);
 }
 
 bool isSpd(const Eigen::MatrixXd& P)

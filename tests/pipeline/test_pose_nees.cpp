@@ -12,6 +12,7 @@
 // curved over the phi2 uncertainty for a Gaussian C_R, even to second
 // order, and accuracy-map's summary shows how the NEES grows there). At
 // least 200 such sightings are required.
+#include <mrpt/math/distributions.h>
 #include <codemark/detect/detector.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/pipeline/pipeline.h>
@@ -30,14 +31,11 @@ using namespace codemark;
 
 namespace
 {
-// 95% band of the mean of n chi-square(3) variables: chi2(3n) / n, quantiles
-// from the Wilson-Hilferty approximation (accurate to well under 1% here).
+// 95% band of the mean of n chi-square(3) variables: chi2(3n) / n.
 std::pair<double, double> neesBand(int n)
 {
-	const double k = 3.0 * n, h = 2.0 / (9 * k), z = 1.959963984540054;
-	return {
-		k * std::pow(1 - h - z * std::sqrt(h), 3) / n,
-		k * std::pow(1 - h + z * std::sqrt(h), 3) / n};
+	const auto k = static_cast<unsigned>(3 * n);
+	return {mrpt::math::chi2inv(0.025, k) / n, mrpt::math::chi2inv(0.975, k) / n};
 }
 
 struct NeesResult

@@ -14,6 +14,8 @@
 
 #include "common.h"
 
+#include "../common/numeric_diff.h"
+
 using namespace codemark;
 using namespace codemark::pose;
 using codemark::test::cameraAt;
@@ -35,22 +37,6 @@ void expectJacobianNear(const A& analytic, const B& numeric, double rel, const s
 			EXPECT_NEAR(analytic(r, c), numeric(r, c), rel * scale)
 				<< what << " row " << r << " col " << c;
 	}
-}
-
-// Central differences of \a f at \a x, step 1e-6 max(1, |x_k|).
-template <int Out, int In, typename F>
-Eigen::Matrix<double, Out, In> numericJacobian(const F& f, const Eigen::Matrix<double, In, 1>& x)
-{
-	Eigen::Matrix<double, Out, In> J;
-	for (int k = 0; k < In; ++k)
-	{
-		const double h = 1e-6 * std::max(1.0, std::abs(x[k]));
-		Eigen::Matrix<double, In, 1> a = x, b = x;
-		a[k] += h;
-		b[k] -= h;
-		J.col(k) = (f(a) - f(b)) / (2 * h);
-	}
-	return J;
 }
 
 struct Config
@@ -124,7 +110,7 @@ TEST(ClosedForm, JacobianOfPrimaryMatchesCentralDifferences)
 			projectCorners(cameraAt(c.d, c.angle, c.z, c.phi1), cam, g), cam, &lambda);
 		Eigen::Matrix<double, 3, 4> J;
 		landmarkFromPrimary(P, lambda, g.innerHalf(), &J);
-		const auto Jn = numericJacobian<3, 4>(
+		const Eigen::MatrixXd Jn = codemark::test::numericJacobian(
 			[&](const Eigen::Vector4d& p) { return landmarkFromPrimary(p, lambda, g.innerHalf()); },
 			P);
 		expectJacobianNear(J, Jn, 1e-6, "J_P");
@@ -145,7 +131,7 @@ TEST(ClosedForm, PrimaryFromLandmarkInvertsTheClosedForm)
 		const Eigen::Vector4d back = primaryFromLandmark(L, lambda, g.innerHalf(), &J);
 		EXPECT_LT((back - P).cwiseAbs().maxCoeff(), 1e-9 * P.cwiseAbs().maxCoeff())
 			<< "d " << c.d << " angle " << c.angle;
-		const auto Jn = numericJacobian<4, 3>(
+		const Eigen::MatrixXd Jn = codemark::test::numericJacobian(
 			[&](const Eigen::Vector3d& l) { return primaryFromLandmark(l, lambda, g.innerHalf()); },
 			L);
 		expectJacobianNear(J, Jn, 1e-6, "dP/dL");

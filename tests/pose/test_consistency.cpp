@@ -44,11 +44,10 @@ TEST(Consistency, MeanNeesInsideTheChiSquareBand)
 			sum += e.dot(m.C_R.ldlt().solve(e));
 		}
 		const double mean = sum / N;
-		// 95% band of the mean of N chi-square(3) variables: chi2(3N) / N,
-		// quantiles from the Wilson-Hilferty approximation.
-		const double k = 3.0 * N, h = 2.0 / (9 * k), zq = 1.959963984540054;
-		const double lo = k * std::pow(1 - h - zq * std::sqrt(h), 3) / N;
-		const double hi = k * std::pow(1 - h + zq * std::sqrt(h), 3) / N;
+		// 95% band of the mean of N chi-square(3) variables: chi2(3N) / N.
+		const auto k = static_cast<unsigned>(3 * N);
+		const double lo = mrpt::math::chi2inv(0.025, k) / N;
+		const double hi = mrpt::math::chi2inv(0.975, k) / N;
 		EXPECT_GT(mean, lo) << toString(method);
 		EXPECT_LT(mean, hi) << toString(method);
 		std::cout << "[ NEES ] " << toString(method) << ": mean " << mean << " over " << N

@@ -15,6 +15,8 @@
 
 #include "common.h"
 
+#include "../common/numeric_diff.h"
+
 using namespace codemark;
 using namespace codemark::pose;
 using codemark::test::cameraAt;
@@ -289,15 +291,17 @@ namespace
 Eigen::Matrix<double, 4, 8> primaryJacobian(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& cam)
 {
-	Eigen::Matrix<double, 4, 8> J;
-	for (int k = 0; k < 8; ++k)
+	Eigen::Matrix<double, 8, 1> x;
+	for (int k = 0; k < 8; ++k) x[k] = corners[k / 2][k % 2];
+	const auto f = [&](const Eigen::Matrix<double, 8, 1>& v)
 	{
-		auto p = corners, m = corners;
-		p[k / 2][k % 2] += 1e-5;
-		m[k / 2][k % 2] -= 1e-5;
-		J.col(k) = (primaryMeasurement(p, cam) - primaryMeasurement(m, cam)) / 2e-5;
-	}
-	return J;
+		std::array<Eigen::Vector2d, 4> c;
+		for (int k = 0; k < 4; ++k) c[k] = Eigen::Vector2d(v[2 * k], v[2 * k + 1]);
+		return primaryMeasurement(c, cam);
+	};
+	// Steps of 1e-7 of the coordinates (a few hundredths of a micro-pixel
+	// per pixel of coordinate).
+	return codemark::test::numericJacobian(f, x, 1e-7);
 }
 }  // namespace
 

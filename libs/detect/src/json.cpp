@@ -1,5 +1,7 @@
 #include <codemark/detect/json.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -8,38 +10,9 @@ namespace codemark::detect
 {
 std::string jsonString(const std::string& s)
 {
-	std::string out = "\"";
-	for (const unsigned char c : s)
-	{
-		switch (c)
-		{
-			case '"':
-				out += "\\\"";
-				break;
-			case '\\':
-				out += "\\\\";
-				break;
-			case '\n':
-				out += "\\n";
-				break;
-			case '\r':
-				out += "\\r";
-				break;
-			case '\t':
-				out += "\\t";
-				break;
-			default:
-				if (c < 0x20)
-				{
-					char buf[8];
-					std::snprintf(buf, sizeof buf, "\\u%04x", c);
-					out += buf;
-				}
-				else
-					out += static_cast<char>(c);
-		}
-	}
-	return out + "\"";
+	// Invalid UTF-8 (a file name in another encoding) becomes U+FFFD, not
+	// an exception.
+	return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string jsonNumber(double v)

@@ -16,6 +16,7 @@
 #include <mrpt/opengl/CText.h>
 #include <mrpt/poses/CPoint2D.h>
 #include <mrpt/serialization/CArchive.h>
+#include <nlohmann/json.hpp>
 
 #include <Eigen/Dense>
 #include <chrono>
@@ -371,61 +372,63 @@ void summariseInnovations(LocalizeSummary& s)
 
 std::string summaryJson(const LocalizeSummary& s)
 {
-	std::ostringstream o;
-	o << "{\n";
-	o << "  \"method\": \"" << s.method << "\",\n";
-	o << "  \"steps\": " << s.steps << ",\n";
-	o << "  \"sightings_used\": " << s.sightings_used << ",\n";
-	o << "  \"sightings_rejected\": " << s.sightings_rejected << ",\n";
-	o << "  \"sightings_unknown_id\": " << s.sightings_unknown_id << ",\n";
-	o << "  \"sightings_too_oblique\": " << s.sightings_too_oblique << ",\n";
-	o << "  \"reinitializations\": " << s.reinitializations << ",\n";
-	o << "  \"first_fix_step\": " << s.first_fix_step << ",\n";
-	o << "  \"first_fix_time_s\": " << num(s.first_fix_time_s, 3) << ",\n";
-	o << "  \"detect_ms_per_image\": " << num(s.detect_ms_per_image, 3) << ",\n";
-	o << "  \"nis_mean\": " << num(s.nis_mean, 4) << ",\n";
-	o << "  \"nis_dof\": " << num(s.nis_dof, 3) << ",\n";
-	o << "  \"nis_count\": " << s.nis_count << ",\n";
-	o << "  \"gated_fraction\": " << num(s.gated_fraction, 4) << ",\n";
-	o << "  \"nis_verdict\": \"" << s.nis_verdict << "\",\n";
-	o << "  \"nis_sighting_share\": " << num(s.nis_sighting_share, 4) << ",\n";
-	o << "  \"nis_visits\": " << s.nis_visits << ",\n";
-	o << "  \"nis_visit_ratio\": " << num(s.nis_visit_ratio, 4) << ",\n";
-	o << "  \"persistent_errors\": " << (s.persistent_errors ? "true" : "false") << ",\n";
+	// Numbers rounded to their meaningful decimals; non-finite ones null.
+	const auto num = [](double v, int decimals) -> nlohmann::ordered_json
+	{
+		if (!std::isfinite(v)) return nullptr;
+		const double k = std::pow(10.0, decimals);
+		return std::round(v * k) / k;
+	};
+	nlohmann::ordered_json j;
+	j["method"] = s.method;
+	j["steps"] = s.steps;
+	j["sightings_used"] = s.sightings_used;
+	j["sightings_rejected"] = s.sightings_rejected;
+	j["sightings_unknown_id"] = s.sightings_unknown_id;
+	j["sightings_too_oblique"] = s.sightings_too_oblique;
+	j["reinitializations"] = s.reinitializations;
+	j["first_fix_step"] = s.first_fix_step;
+	j["first_fix_time_s"] = num(s.first_fix_time_s, 3);
+	j["detect_ms_per_image"] = num(s.detect_ms_per_image, 3);
+	j["nis_mean"] = num(s.nis_mean, 4);
+	j["nis_dof"] = num(s.nis_dof, 3);
+	j["nis_count"] = s.nis_count;
+	j["gated_fraction"] = num(s.gated_fraction, 4);
+	j["nis_verdict"] = s.nis_verdict;
+	j["nis_sighting_share"] = num(s.nis_sighting_share, 4);
+	j["nis_visits"] = s.nis_visits;
+	j["nis_visit_ratio"] = num(s.nis_visit_ratio, 4);
+	j["persistent_errors"] = s.persistent_errors;
 	if (s.metrics)
 	{
 		const auto& m = *s.metrics;
-		o << "  \"gt_matched_steps\": " << m.matched << ",\n";
-		o << "  \"ate_rmse_m\": " << num(m.ate_rmse_m, 6) << ",\n";
-		o << "  \"max_error_m\": " << num(m.max_error_m, 6) << ",\n";
-		o << "  \"yaw_rmse_deg\": " << num(m.yaw_rmse_deg, 4) << ",\n";
-		o << "  \"nees_mean\": " << num(m.nees_mean, 4) << ",\n";
-		o << "  \"nees_band_95\": [" << num(m.nees_band_low, 4) << ", " << num(m.nees_band_high, 4)
-		  << "],\n";
-		// SLAM without a prior map: its frame is the robot's start; the
-		// errors above are after an SE(2) least-squares alignment.
-		// ate, max and yaw errors after an SE(2) least-squares alignment,
-		// NEES in the frame anchored at the true first pose (the SLAM
-		// covariance is relative to the start).
-		o << "  \"alignment\": \"" << (m.aligned ? "se2_least_squares" : "none") << "\",\n";
+		j["gt_matched_steps"] = m.matched;
+		j["ate_rmse_m"] = num(m.ate_rmse_m, 6);
+		j["max_error_m"] = num(m.max_error_m, 6);
+		j["yaw_rmse_deg"] = num(m.yaw_rmse_deg, 4);
+		j["nees_mean"] = num(m.nees_mean, 4);
+		j["nees_band_95"] = {num(m.nees_band_low, 4), num(m.nees_band_high, 4)};
+		// SLAM without a prior map: ate, max and yaw errors after an SE(2)
+		// least-squares alignment, NEES in the frame anchored at the true
+		// first pose (the SLAM covariance is relative to the start).
+		j["alignment"] = m.aligned ? "se2_least_squares" : "none";
 		if (m.aligned)
 		{
-			o << "  \"alignment_truth_T_estimate\": [" << num(m.truth_T_estimate.x(), 6) << ", "
-			  << num(m.truth_T_estimate.y(), 6) << ", " << num(m.truth_T_estimate.phi(), 6)
-			  << "],\n";
-			o << "  \"nees_frame\": \"anchored_at_true_first_pose\",\n";
-			o << "  \"ate_rmse_anchored_m\": " << num(m.ate_rmse_anchored_m, 6) << ",\n";
+			j["alignment_truth_T_estimate"] = {
+				num(m.truth_T_estimate.x(), 6), num(m.truth_T_estimate.y(), 6),
+				num(m.truth_T_estimate.phi(), 6)};
+			j["nees_frame"] = "anchored_at_true_first_pose";
+			j["ate_rmse_anchored_m"] = num(m.ate_rmse_anchored_m, 6);
 		}
 		if (m.landmarks_matched > 0)
 		{
-			o << "  \"landmarks_matched\": " << m.landmarks_matched << ",\n";
-			o << "  \"landmark_rmse_m\": " << num(m.landmark_rmse_m, 6) << ",\n";
-			o << "  \"landmark_yaw_rmse_deg\": " << num(m.landmark_yaw_rmse_deg, 4) << ",\n";
+			j["landmarks_matched"] = m.landmarks_matched;
+			j["landmark_rmse_m"] = num(m.landmark_rmse_m, 6);
+			j["landmark_yaw_rmse_deg"] = num(m.landmark_yaw_rmse_deg, 4);
 		}
 	}
-	o << "  \"time_per_step_ms\": " << num(s.time_per_step_ms, 4) << "\n";
-	o << "}\n";
-	return o.str();
+	j["time_per_step_ms"] = num(s.time_per_step_ms, 4);
+	return j.dump(2) + "\n";
 }
 
 void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::string& dir)

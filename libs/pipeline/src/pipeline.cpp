@@ -52,7 +52,8 @@ ImageResult processImage(
 		}
 		catch (const std::invalid_argument&)
 		{
-			continue;  // degenerate corners: no measurement, no sighting
+			r.unmeasured.push_back(d);	// degenerate corners: no measurement, no sighting
+			continue;
 		}
 		r.landmarks.push_back(std::move(m));
 	}

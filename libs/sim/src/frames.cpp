@@ -1,3 +1,4 @@
+#include <nlohmann/json.hpp>
 #include <codemark/landmark/text.h>
 #include <codemark/sim/frames.h>
 
@@ -98,19 +99,7 @@ namespace
 {
 std::string jsonString(const std::string& s)
 {
-	std::ostringstream o;
-	o << '"';
-	for (char c : s)
-	{
-		if (c == '"' || c == '\\')
-			o << '\\' << c;
-		else if (static_cast<unsigned char>(c) < 0x20)
-			o << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-		else
-			o << c;
-	}
-	o << '"';
-	return o.str();
+	return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 template <typename Vec>

@@ -64,6 +64,8 @@ struct MeasuredLandmark
 struct ImageResult
 {
 	std::vector<MeasuredLandmark> landmarks;
+	/** Detections whose corners gave no measurement (degenerate). */
+	std::vector<detect::DetectedLandmark> unmeasured;
 	detect::StageTimings timings;  //!< the detector's own time
 	double pose_us = 0;	 //!< time spent in the pose library [us]
 };
