@@ -42,20 +42,34 @@ gt     = dataset/gt_path.txt
 INI
 "$BIN/codemark-bench/codemark-bench" --config "$OUT/bench.ini" --out "$OUT/bench" --methods ekf,pf
 
+# The summary, on stdout and as a report (summary.md).
+summary() {
+	echo "== summary (ground truth: $OUT/dataset/gt_path.txt; RPE over 1 s; NEES 95% band of a consistent filter)"
+	printf '%-6s %6s %9s %9s %9s %13s %16s %10s %9s %8s\n' method steps ATE[m] max[m] RPE[m] yawRMSE[deg] \
+		"NEES [band]" fix[s] ms/step NIS/DoF
+	# results.csv: one row per method; the columns are named in its header.
+	awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+	  { printf "%-6s %6d %9.4f %9.4f %9.4f %13.3f %6.2f [%.2f,%.2f] %10.1f %9.4f %8.2f\n", $c["method"],
+	    $c["steps"], $c["ate_m"], $c["max_error_m"], $c["rpe_trans_m"], $c["yaw_rmse_deg"],
+	    $c["nees_mean"], $c["nees_low_95"], $c["nees_high_95"], $c["first_fix_s"],
+	    $c["filter_ms_per_step"], $c["nis_mean"] / $c["nis_dof"] }' "$OUT/bench/results.csv"
+}
 echo
-echo "== summary (ground truth: $OUT/dataset/gt_path.txt; RPE over 1 s; NEES 95% band of a consistent filter)"
-printf '%-6s %6s %9s %9s %9s %13s %16s %10s %9s\n' method steps ATE[m] max[m] RPE[m] yawRMSE[deg] \
-  "NEES [band]" fix[s] ms/step
-# results.csv: one row per method; the columns are named in its header.
-awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
-  { printf "%-6s %6d %9.4f %9.4f %9.4f %13.3f %6.2f [%.2f,%.2f] %10.1f %9.4f\n", $c["method"],
-    $c["steps"], $c["ate_m"], $c["max_error_m"], $c["rpe_trans_m"], $c["yaw_rmse_deg"],
-    $c["nees_mean"], $c["nees_low_95"], $c["nees_high_95"], $c["first_fix_s"],
-    $c["filter_ms_per_step"] }' "$OUT/bench/results.csv"
+summary
+{
+	echo "# codemark demo"
+	echo
+	echo "Written by \`scripts/demo.sh\` on $(date -u '+%Y-%m-%d %H:%M UTC') ($(nproc) cores, $(uname -m)),"
+	echo "commit $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)."
+	echo
+	echo '```'
+	summary
+	echo '```'
+} >"$OUT/summary.md"
 echo "(codemark-bench seeds each job; codemark-localize's pf line above draws other random numbers)"
 echo
 echo "plots: $OUT/ekf/trajectory.png $OUT/pf/trajectory.png (estimate, truth, 95% ellipses)"
 echo "       $OUT/bench/demo-error.png (position error against time with the 3-sigma bound)"
 echo "       $OUT/bench/demo-trajectories.png (both estimates over the ground truth)"
-echo "report: $OUT/bench/report.md"
+echo "report: $OUT/bench/report.md; this summary: $OUT/summary.md"
 echo "demo: done in $(( $(date +%s) - start )) s after the build; outputs in $OUT/"

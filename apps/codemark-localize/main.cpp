@@ -2,10 +2,12 @@
 // rawlog and writes the outputs of docs/spec.md section 6. The logic is
 // codemark::filters::runLocalization (libs/filters/src/outputs.cpp).
 #include <codemark/filters/outputs.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
 #include <tclap/CmdLine.h>
 
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -107,7 +109,15 @@ int main(int argc, char** argv)
 			on_step = [&](const codemark::filters::LocalizeSummary& so_far,
 						  const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
 			{ view->update(so_far, m, f); };
-		codemark::app::ProgressBar bar("codemark-localize", !quiet.getValue());
+		// The label names the method: two runs over one rawlog (the demo's
+		// ekf and pf) draw distinguishable progress lines.
+		std::string method_name = req.method;
+		if (method_name.empty() && std::ifstream(req.config_file).good())
+			method_name =
+				mrpt::config::CConfigFile(req.config_file).read_string("localize", "method", "ekf");
+		codemark::app::ProgressBar bar(
+			"codemark-localize" + (method_name.empty() ? "" : " (" + method_name + ")"),
+			!quiet.getValue());
 		codemark::LandmarkMap used_map;
 		const auto s = codemark::filters::runLocalization(
 			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); },
