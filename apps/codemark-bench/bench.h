@@ -4,10 +4,10 @@
  * through one method), the metrics that libs/filters does not compute
  * itself (RPE, aligned ATE, detection rate against the ground truth), and
  * the report (CSV, Markdown, plots). App-internal: the per-job loop mirrors
- * filters::runLocalization() with per-frame detection bookkeeping added, so
+ * eval::runLocalization() with per-frame detection bookkeeping added, so
  * that libs/ stays untouched.
  */
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 
 #include <functional>
 #include <optional>
@@ -101,7 +101,7 @@ struct JobResult
 	std::string dataset, method;
 	bool ok = false;
 	std::string error;	//!< one line when !ok
-	filters::LocalizeSummary summary;  //!< rows, metrics, first fix, per-step time
+	eval::LocalizeSummary summary;  //!< rows, metrics, first fix, per-step time
 	DetectionStats detection;
 	std::optional<Rpe> rpe;
 	std::optional<Alignment> aligned;  //!< ATE after the best SE(2) alignment
@@ -121,11 +121,11 @@ JobResult runJob(
 	const std::function<void(double)>& progress = {});
 
 /** RPE of \a rows over \a interval_s; none when no pair matches. */
-std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, double interval_s);
+std::optional<Rpe> relativePoseError(const std::vector<eval::PathRow>& rows, double interval_s);
 
 /** The Alignment of \a rows (initialised, with truth); none with fewer than
  * 2 such rows. */
-std::optional<Alignment> alignPath(const std::vector<filters::PathRow>& rows);
+std::optional<Alignment> alignPath(const std::vector<eval::PathRow>& rows);
 
 /** results.csv's header line (no newline). */
 std::string csvHeader();

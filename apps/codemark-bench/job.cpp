@@ -1,7 +1,7 @@
 // codemark-bench: one job = one dataset through one method, and the metrics
 // libs/filters does not compute (RPE, aligned ATE, detection rate).
 #include <codemark/landmark/random.h>
-#include <codemark/filters/ground_truth.h>
+#include <codemark/eval/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
@@ -89,9 +89,9 @@ void tallyDetections(
 }
 }  // namespace
 
-std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, double interval_s)
+std::optional<Rpe> relativePoseError(const std::vector<eval::PathRow>& rows, double interval_s)
 {
-	std::vector<const filters::PathRow*> ok;
+	std::vector<const eval::PathRow*> ok;
 	for (const auto& r : rows)
 		if (r.estimate.initialized && r.truth) ok.push_back(&r);
 	Rpe rpe;
@@ -115,7 +115,7 @@ std::optional<Rpe> relativePoseError(const std::vector<filters::PathRow>& rows, 
 	return rpe;
 }
 
-std::optional<Alignment> alignPath(const std::vector<filters::PathRow>& rows)
+std::optional<Alignment> alignPath(const std::vector<eval::PathRow>& rows)
 {
 	std::vector<Eigen::Vector2d> e, g;
 	for (const auto& r : rows)
@@ -170,7 +170,7 @@ JobResult runJob(
 		const bool mrpt_map = filters::isMrptLandmarksFile(ds.map);
 		const LandmarkMap map =
 			mrpt_map ? filters::loadMrptLandmarksFile(ds.map) : LandmarkMap::load(ds.map);
-		const filters::GroundTruth gt = filters::GroundTruth::load(ds.gt);
+		const eval::GroundTruth gt = eval::GroundTruth::load(ds.gt);
 		std::optional<CameraModel> camera;
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
 
@@ -207,7 +207,7 @@ JobResult runJob(
 			}
 			const filters::StepStats st = filter->step(step.odometry.get(), step.observations);
 			filter_s += seconds(t0, Clock::now());
-			filters::PathRow row;
+			eval::PathRow row;
 			row.step = step.index;
 			row.timestamp = step.timestamp;
 			row.estimate = filter->estimate();
@@ -241,11 +241,11 @@ JobResult runJob(
 		// SLAM without a prior map estimates in the frame of the robot's
 		// start: its ATE and NEES after the alignment (NEES anchored at the
 		// true first pose), as codemark-localize reports them.
-		s.metrics = filters::computeMetrics(s.rows, prior.landmarks.empty());
-		filters::summariseInnovations(s);
+		s.metrics = eval::computeMetrics(s.rows, prior.landmarks.empty());
+		eval::summariseInnovations(s);
 		r.rpe = relativePoseError(s.rows, cfg.rpe_interval_s);
 		r.aligned = alignPath(s.rows);
-		filters::writeOutputs(s, map, out_dir);
+		eval::writeOutputs(s, map, out_dir);
 		r.ok = true;
 	}
 	catch (const std::exception& e)

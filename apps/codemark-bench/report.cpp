@@ -38,7 +38,7 @@ std::optional<double> ratio(long num, long den)
 	if (den <= 0) return std::nullopt;
 	return static_cast<double>(num) / den;
 }
-bool neesInside(const filters::PathMetrics& m)
+bool neesInside(const eval::PathMetrics& m)
 {
 	return m.nees_mean >= m.nees_band_low && m.nees_mean <= m.nees_band_high;
 }

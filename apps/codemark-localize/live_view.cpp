@@ -27,7 +27,7 @@ struct LiveView::Impl
 	bool camera_set = false;
 };
 
-LiveView::LiveView(int every_n_steps, const std::optional<filters::GroundTruth>& gt)
+LiveView::LiveView(int every_n_steps, const std::optional<eval::GroundTruth>& gt)
 	: impl_(std::make_unique<Impl>()), every_n_(std::max(1, every_n_steps)), gt_(gt)
 {
 	requireDisplay();
@@ -42,7 +42,7 @@ LiveView::LiveView(int every_n_steps, const std::optional<filters::GroundTruth>&
 LiveView::~LiveView() = default;
 
 void LiveView::update(
-	const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f)
+	const eval::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f)
 {
 	if (s.steps % every_n_ != 0) return;
 	std::vector<filters::MappedLandmark> lms = f.landmarks();
@@ -51,7 +51,7 @@ void LiveView::update(
 	draw(s, lms);
 }
 
-void LiveView::finish(const filters::LocalizeSummary& s, const LandmarkMap& map, bool wait_for_key)
+void LiveView::finish(const eval::LocalizeSummary& s, const LandmarkMap& map, bool wait_for_key)
 {
 	std::vector<filters::MappedLandmark> lms = s.slam_map;
 	if (lms.empty())
@@ -69,7 +69,7 @@ void LiveView::finish(const filters::LocalizeSummary& s, const LandmarkMap& map,
 }
 
 void LiveView::draw(
-	const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks)
+	const eval::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks)
 {
 	if (!impl_->win || !impl_->win->isOpen()) return;  // closed by the user: the run goes on
 	double xmin = 1e9, xmax = -1e9, ymin = 1e9, ymax = -1e9;
@@ -100,7 +100,7 @@ void LiveView::draw(
 		auto est = mrpt::opengl::CSetOfLines::Create();
 		est->setColor_u8(0, 0, 255);
 		est->setLineWidth(2);
-		const filters::PathRow* last = nullptr;
+		const eval::PathRow* last = nullptr;
 		for (const auto& r : s.rows)
 		{
 			if (!r.estimate.initialized) continue;

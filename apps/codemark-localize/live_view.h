@@ -5,8 +5,8 @@
  * landmarks (red points; for SLAM the filter's current map), the current
  * pose (axes) with its 95% position ellipse. World frame, metres.
  */
-#include <codemark/filters/ground_truth.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/ground_truth.h>
+#include <codemark/eval/localization.h>
 
 #include <memory>
 #include <optional>
@@ -19,25 +19,25 @@ class LiveView
    public:
 	/** Opens the window. \a every_n_steps >= 1: redraw period [steps].
 	 * Throws std::runtime_error (one line) when no X display can be opened. */
-	LiveView(int every_n_steps, const std::optional<filters::GroundTruth>& gt);
+	LiveView(int every_n_steps, const std::optional<eval::GroundTruth>& gt);
 	~LiveView();
 
 	/** The StepObserver of runLocalization: redraws every N steps. */
 	void update(
-		const filters::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f);
+		const eval::LocalizeSummary& s, const LandmarkMap& map, const filters::Localizer& f);
 
 	/** Draws the final state; with \a wait_for_key, waits for a key press in
 	 * the window (or its closing) before returning. */
-	void finish(const filters::LocalizeSummary& s, const LandmarkMap& map, bool wait_for_key);
+	void finish(const eval::LocalizeSummary& s, const LandmarkMap& map, bool wait_for_key);
 
    private:
 	void draw(
-		const filters::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks);
+		const eval::LocalizeSummary& s, const std::vector<filters::MappedLandmark>& landmarks);
 
 	struct Impl;
 	std::unique_ptr<Impl> impl_;
 	int every_n_ = 1;
-	std::optional<filters::GroundTruth> gt_;
+	std::optional<eval::GroundTruth> gt_;
 };
 
 }  // namespace codemark::app

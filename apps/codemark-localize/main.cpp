@@ -1,7 +1,7 @@
 // codemark-localize: runs one filter (ekf, ekf-pose, ekf-slam, pf) over a
 // rawlog and writes the outputs of docs/spec.md section 6. The logic is
-// codemark::filters::runLocalization (libs/filters/src/outputs.cpp).
-#include <codemark/filters/outputs.h>
+// codemark::eval::runLocalization (libs/filters/src/outputs.cpp).
+#include <codemark/eval/localization.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
 #include <tclap/CmdLine.h>
@@ -85,7 +85,7 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
 		cmd.parse(argc, argv);
 
-		codemark::filters::LocalizeRequest req;
+		codemark::eval::LocalizeRequest req;
 		req.config_file = config.getValue();
 		req.rawlog = rawlog.getValue();
 		req.map_file = map.getValue();
@@ -100,13 +100,13 @@ int main(int argc, char** argv)
 		std::unique_ptr<codemark::app::LiveView> view;
 		if (gui.getValue())
 		{
-			std::optional<codemark::filters::GroundTruth> gt_path;
-			if (!req.gt_file.empty()) gt_path = codemark::filters::GroundTruth::load(req.gt_file);
+			std::optional<codemark::eval::GroundTruth> gt_path;
+			if (!req.gt_file.empty()) gt_path = codemark::eval::GroundTruth::load(req.gt_file);
 			view = std::make_unique<codemark::app::LiveView>(gui_every.getValue(), gt_path);
 		}
-		codemark::filters::StepObserver on_step;
+		codemark::eval::StepObserver on_step;
 		if (view)
-			on_step = [&](const codemark::filters::LocalizeSummary& so_far,
+			on_step = [&](const codemark::eval::LocalizeSummary& so_far,
 						  const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
 			{ view->update(so_far, m, f); };
 		// The label names the method: two runs over one rawlog (the demo's
@@ -119,16 +119,16 @@ int main(int argc, char** argv)
 			"codemark-localize" + (method_name.empty() ? "" : " (" + method_name + ")"),
 			!quiet.getValue());
 		codemark::LandmarkMap used_map;
-		const auto s = codemark::filters::runLocalization(
+		const auto s = codemark::eval::runLocalization(
 			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); },
-			view ? codemark::filters::StepObserver(
-					   [&](const codemark::filters::LocalizeSummary& so_far,
+			view ? codemark::eval::StepObserver(
+					   [&](const codemark::eval::LocalizeSummary& so_far,
 						   const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
 					   {
 						   used_map = m;
 						   on_step(so_far, m, f);
 					   })
-				 : codemark::filters::StepObserver());
+				 : codemark::eval::StepObserver());
 		bar.finish();
 		if (s.steps == 0)
 			throw std::runtime_error(

@@ -6,9 +6,9 @@
 // scripts/bench-filters.sh). Images are detected once per dataset and every
 // filter runs on the same steps.
 #include <codemark/filters/ekf.h>
-#include <codemark/filters/ground_truth.h>
+#include <codemark/eval/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
 #include <codemark/sim/dataset.h>
@@ -29,6 +29,7 @@
 namespace fs = std::filesystem;
 using namespace codemark;
 using namespace codemark::filters;
+using namespace codemark::eval;
 using Clock = std::chrono::steady_clock;
 
 namespace
@@ -56,8 +57,8 @@ sim::DatasetSummary loadDataset(const fs::path& dir)
 	sim::DatasetSummary ds;
 	ds.map = LandmarkMap::load((dir / "map.txt").string());
 	const std::string gt_path = (dir / "gt_path.txt").string();
-	const auto gt = filters::GroundTruth::load(gt_path);
-	if (gt.form() != filters::GroundTruth::Form::Timestamped)
+	const auto gt = eval::GroundTruth::load(gt_path);
+	if (gt.form() != eval::GroundTruth::Form::Timestamped)
 		throw std::runtime_error(gt_path + ": expected 'timestamp x y yaw' rows");
 	for (size_t i = 0; i < gt.size(); ++i)
 		ds.ground_truth.push_back({gt.times()[i], gt.poses()[i]});

@@ -1,5 +1,5 @@
 // The normalised innovation squared and the verdict on a run's innovations.
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -7,6 +7,7 @@
 #include <random>
 
 using namespace codemark::filters;
+using namespace codemark::eval;
 
 TEST(Innovation, NisAndLogDetMatchTheirDefinitions)
 {

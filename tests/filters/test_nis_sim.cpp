@@ -12,7 +12,7 @@
 // default odometry the prediction dominates S and the verdict is blind to a
 // factor of 9 in C_P (docs/design.md).
 #include <codemark/filters/noise_fit.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/pipeline/annotate.h>
 #include <codemark/pose/calibration.h>
 #include <codemark/sim/dataset.h>
@@ -24,6 +24,7 @@
 namespace fs = std::filesystem;
 using namespace codemark;
 using namespace codemark::filters;
+using namespace codemark::eval;
 
 namespace
 {

@@ -3,7 +3,7 @@
 // error, both rawlog formats, with the shipped share/codemark/config/ekf.ini
 // and the calibration of the simulated datasets' renders (realistic: linear
 // light, no camera pipeline).
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/sim/dataset.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,6 +13,7 @@
 namespace fs = std::filesystem;
 using namespace codemark;
 using namespace codemark::filters;
+using namespace codemark::eval;
 
 namespace
 {

@@ -1,5 +1,5 @@
 // The coded-landmark map (CCodedLandmarksMap) and the particle filter.
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/filters/particle_filter.h>
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <gtest/gtest.h>
@@ -434,14 +434,14 @@ TEST(ParticleFilter, NonFiniteStateInARunNamesTheRawlogEntry)
 			ar << sf;
 		}
 	}
-	codemark::filters::LocalizeRequest req;
+	codemark::eval::LocalizeRequest req;
 	req.config_file = std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/pf.ini";
 	req.method = "pf";
 	req.rawlog = rawlog;
 	req.map_file = dir + "/map.txt";
 	try
 	{
-		codemark::filters::runLocalization(req);
+		codemark::eval::runLocalization(req);
 		ADD_FAILURE() << "no error: " << dir;
 		return;
 	}

@@ -4,7 +4,7 @@
 #include <codemark/filters/ekf_slam.h>
 #include <codemark/filters/localizer.h>
 #include <codemark/filters/mrpt_landmarks.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/landmark/truth.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
 #include <codemark/pose/closed_form.h>
@@ -26,6 +26,7 @@
 
 using namespace codemark;
 using namespace codemark::filters;
+using namespace codemark::eval;
 
 namespace
 {

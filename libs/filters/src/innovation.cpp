@@ -4,7 +4,9 @@
 #include <mrpt/math/distributions.h>
 
 #include <Eigen/Cholesky>
+#include <iomanip>
 #include <set>
+#include <sstream>
 #include <cmath>
 #include <limits>
 
@@ -72,6 +74,20 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 	r.persistent_errors = r.visits >= 3 && r.other_ratio > 0 &&
 						  visit_nis / r.other_ratio > mrpt::math::chi2inv(0.99, visit_dof);
 	return r;
+}
+
+std::string nisVerdict(double nis_mean, double nis_dof, long count)
+{
+	if (count <= 0 || !(nis_dof > 0)) return "no sightings tested";
+	const double k = nis_mean / nis_dof;
+	if (k >= kNisConsistentLow && k <= kNisConsistentHigh) return "consistent";
+	std::ostringstream o;
+	o << std::setprecision(2);
+	if (k > kNisConsistentHigh)
+		o << "covariances too small by about " << k << "x";
+	else
+		o << "covariances too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
+	return o.str();
 }
 
 }  // namespace codemark::filters

@@ -101,4 +101,11 @@ std::map<int, Eigen::Vector2d> rangeBearingSlamLandmarks(
 	return out;
 }
 
+LandmarkMap loadAnyMap(const std::string& path)
+{
+	if (isMrptLandmarksFile(path)) return loadMrptLandmarksFile(path);
+	return LandmarkMap::load(path);
+}
+
+
 }  // namespace codemark::filters

@@ -3,7 +3,6 @@
 #include <codemark/filters/ekf.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/noise_fit.h>
-#include <codemark/filters/outputs.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pipeline/pipeline.h>
 #include <mrpt/config/CConfigFile.h>

@@ -138,4 +138,22 @@ std::unique_ptr<Localizer> makeLocalizer(
 	const std::string& method, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
 	const std::optional<PoseEstimate>& initial = std::nullopt);
 
+/** The initial pose of a config's [localize] section (initial_pose_known,
+ * initial_x, initial_y [m], initial_yaw_deg, initial_std_xy [m],
+ * initial_std_yaw_deg), or none (global initialisation). Throws
+ * std::invalid_argument on a non-positive standard deviation. */
+std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg);
+
+/** The band of nis_mean / nis_dof that reads as consistent: wide, because
+ * consecutive sightings of one landmark share the prediction's error and
+ * are correlated. */
+constexpr double kNisConsistentLow = 0.5, kNisConsistentHigh = 2.0;
+
+/** The verdict on a run's innovations: "consistent" when K = \a nis_mean /
+ * \a nis_dof lies in [kNisConsistentLow, kNisConsistentHigh], else
+ * "covariances too small by about Kx" (K > 2) or "covariances too large by
+ * about (1/K)x" (K < 0.5), K with 2 significant digits; "no sightings tested"
+ * when \a count is 0. */
+std::string nisVerdict(double nis_mean, double nis_dof, long count);
+
 }  // namespace codemark::filters

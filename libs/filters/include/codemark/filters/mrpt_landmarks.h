@@ -45,4 +45,8 @@ bool isMrptLandmarksFile(const std::string& path);
 std::map<int, Eigen::Vector2d> rangeBearingSlamLandmarks(
 	const mrpt::slam::CRangeBearingKFSLAM2D& kf);
 
+/** A landmark map from \a path: the spec's format or MRPT's landmark file
+ * (isMrptLandmarksFile()). Throws as LandmarkMap::load(). */
+LandmarkMap loadAnyMap(const std::string& path);
+
 }  // namespace codemark::filters

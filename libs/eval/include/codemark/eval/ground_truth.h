@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace codemark::filters
+namespace codemark::eval
 {
 /** A loaded ground-truth path. */
 class GroundTruth
@@ -57,4 +57,4 @@ class GroundTruth
 	std::vector<mrpt::poses::CPose2D> poses_;
 };
 
-}  // namespace codemark::filters
+}  // namespace codemark::eval

@@ -1,7 +1,7 @@
 // codemark-localize's logic: rawlog -> filter -> output files (spec section 6).
-#include <codemark/filters/ground_truth.h>
+#include <codemark/eval/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/localization.h>
 #include <codemark/filters/stepper.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
@@ -29,8 +29,10 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace codemark::filters
+namespace codemark::eval
 {
+using namespace codemark::filters;
+
 namespace fs = std::filesystem;
 using mrpt::poses::CPose2D;
 
@@ -116,29 +118,6 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
 	m.nees_band_low = mrpt::math::chi2inv(0.025, dof) / m.matched;
 	m.nees_band_high = mrpt::math::chi2inv(0.975, dof) / m.matched;
 	return m;
-}
-
-LandmarkMap loadAnyMap(const std::string& path)
-{
-	if (isMrptLandmarksFile(path)) return loadMrptLandmarksFile(path);
-	return LandmarkMap::load(path);
-}
-
-std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg)
-{
-	if (!cfg.read_bool("localize", "initial_pose_known", false)) return std::nullopt;
-	PoseEstimate e;
-	e.initialized = true;
-	e.mean = CPose2D(
-		cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
-		mrpt::DEG2RAD(cfg.read_double("localize", "initial_yaw_deg", 0)));
-	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
-	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
-	if (!(sxy > 0) || !(syaw > 0))
-		throw std::invalid_argument(
-			"[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
-	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
-	return e;
 }
 
 namespace
@@ -340,25 +319,11 @@ void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::str
 }
 }  // namespace
 
-std::string nisVerdict(double nis_mean, double nis_dof, long count)
-{
-	if (count <= 0 || !(nis_dof > 0)) return "no sightings tested";
-	const double k = nis_mean / nis_dof;
-	if (k >= kNisConsistentLow && k <= kNisConsistentHigh) return "consistent";
-	std::ostringstream o;
-	o << std::setprecision(2);
-	if (k > kNisConsistentHigh)
-		o << "covariances too small by about " << k << "x";
-	else
-		o << "covariances too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
-	return o.str();
-}
-
 void summariseInnovations(LocalizeSummary& s)
 {
 	std::vector<const std::vector<Innovation>*> steps;
 	for (const auto& r : s.rows) steps.push_back(&r.stats.innovations);
-	const InnovationSummary n = summariseInnovations(steps);
+	const InnovationSummary n = filters::summariseInnovations(steps);
 	s.nis_count = n.count;
 	s.nis_mean = n.nis_mean;
 	s.nis_dof = n.nis_dof;
@@ -572,4 +537,4 @@ LocalizeSummary runLocalization(
 	return s;
 }
 
-}  // namespace codemark::filters
+}  // namespace codemark::eval

@@ -1,5 +1,5 @@
 #pragma once
-/** \file outputs.h
+/** \file localization.h
  * The logic of codemark-localize: read a rawlog step by step
  * (RawlogStepper), run one filter (makeLocalizer), and write the outputs of
  * docs/spec.md section 6 into a folder: estimated_path.txt,
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace codemark::filters
+namespace codemark::eval
 {
 /** What to run. */
 struct LocalizeRequest
@@ -48,15 +48,15 @@ struct LocalizeSummary;
  * (empty for SLAM without a prior map) and the filter (e.g. its
  * landmarks()). */
 using StepObserver = std::function<void(
-	const LocalizeSummary& so_far, const LandmarkMap& map, const Localizer& filter)>;
+	const LocalizeSummary& so_far, const LandmarkMap& map, const filters::Localizer& filter)>;
 
 /** One processed camera frame. */
 struct PathRow
 {
 	long step = 0;
 	double timestamp = 0;  //!< UNIX s, or the step index
-	PoseEstimate estimate;
-	StepStats stats;
+	filters::PoseEstimate estimate;
+	filters::StepStats stats;
 	std::optional<mrpt::poses::CPose2D> truth;	//!< matched ground truth
 };
 
@@ -106,7 +106,7 @@ struct LocalizeSummary
 	long sightings_too_oblique = 0;
 	long reinitializations = 0;	 //!< global initialisation and kidnap recoveries
 	/** Innovation consistency over the sightings tested against a
-	 * prediction (fused and gated alike, StepStats::innovations): the mean
+	 * prediction (fused and gated alike, filters::StepStats::innovations): the mean
 	 * NIS, the mean degrees of freedom, how many were tested, the fraction
 	 * gated out, and the verdict (nisVerdict()). */
 	double nis_mean = 0;
@@ -125,24 +125,12 @@ struct LocalizeSummary
 	bool persistent_errors = false;
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
-	double time_per_step_ms = 0;  //!< mean wall time of Localizer::step() [ms]
+	double time_per_step_ms = 0;  //!< mean wall time of filters::Localizer::step() [ms]
 	double detect_ms_per_image = 0;	 //!< mean on-the-fly detection time [ms] (0: none)
 	std::optional<PathMetrics> metrics;	 //!< with ground truth
 	std::vector<PathRow> rows;
-	std::vector<MappedLandmark> slam_map;  //!< SLAM only
+	std::vector<filters::MappedLandmark> slam_map;  //!< SLAM only
 };
-
-/** The band of nis_mean / nis_dof that reads as consistent: wide, because
- * consecutive sightings of one landmark share the prediction's error and
- * are correlated. */
-constexpr double kNisConsistentLow = 0.5, kNisConsistentHigh = 2.0;
-
-/** The verdict on a run's innovations: "consistent" when K = \a nis_mean /
- * \a nis_dof lies in [kNisConsistentLow, kNisConsistentHigh], else
- * "covariances too small by about Kx" (K > 2) or "covariances too large by
- * about (1/K)x" (K < 0.5), K with 2 significant digits; "no sightings tested"
- * when \a count is 0. */
-std::string nisVerdict(double nis_mean, double nis_dof, long count);
 
 /** Sets \a s's NIS fields (nis_mean, nis_dof, nis_count, gated_fraction,
  * nis_verdict) from its rows' innovations; infinite NIS (a covariance that
@@ -160,22 +148,13 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
  * by ID, through \a m's truth_T_estimate (identity when not aligned). The
  * yaw error means nothing for point landmarks. */
 void addLandmarkErrors(
-	PathMetrics& m, const std::vector<MappedLandmark>& estimated, const LandmarkMap& truth);
+	PathMetrics& m, const std::vector<filters::MappedLandmark>& estimated, const LandmarkMap& truth);
 
 /** The SE(2) least-squares alignment b_T_a of 2D points \a a onto \a b
  * (pairs, at least one): closed form (Horn 1987 / Umeyama 1991 in the
  * plane, no scale). */
 mrpt::poses::CPose2D alignSE2(
 	const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b);
-
-/** A landmark map from \a path: the spec's format or MRPT's landmark file
- * (isMrptLandmarksFile()). Throws as LandmarkMap::load(). */
-LandmarkMap loadAnyMap(const std::string& path);
-
-/** The initial pose of a config's [localize] section (initial_pose_known,
- * initial_x, initial_y [m], initial_yaw_deg, initial_std_xy [m],
- * initial_std_yaw_deg), or none (global initialisation). */
-std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg);
 
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
@@ -191,4 +170,4 @@ void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::s
 /** summary.json's text. */
 std::string summaryJson(const LocalizeSummary& s);
 
-}  // namespace codemark::filters
+}  // namespace codemark::eval

@@ -1,7 +1,7 @@
 // Ground-truth files, metrics and the whole codemark-localize run on a
 // synthetic rawlog of landmark observations (no images).
-#include <codemark/filters/ground_truth.h>
-#include <codemark/filters/outputs.h>
+#include <codemark/eval/ground_truth.h>
+#include <codemark/eval/localization.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -12,10 +12,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "common.h"
+#include "../filters/common.h"
 
 using namespace codemark;
 using namespace codemark::filters;
+using namespace codemark::eval;
 using namespace codemark::filters::test;
 using mrpt::poses::CPose2D;
 namespace fs = std::filesystem;

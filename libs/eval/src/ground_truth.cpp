@@ -1,5 +1,5 @@
 // Ground-truth path files (docs/spec.md section 6, both forms).
-#include <codemark/filters/ground_truth.h>
+#include <codemark/eval/ground_truth.h>
 #include <codemark/landmark/text.h>
 
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace codemark::filters
+namespace codemark::eval
 {
 GroundTruth GroundTruth::load(const std::string& path)
 {
@@ -80,4 +80,4 @@ std::optional<mrpt::poses::CPose2D> GroundTruth::poseAt(
 	return poses_[*best];
 }
 
-}  // namespace codemark::filters
+}  // namespace codemark::eval
