@@ -4,7 +4,7 @@
 # share/codemark/calibration/*.ini) and the accuracy map
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,
 # general 6-DoF path and AprilTag 3), writing
-# apps/codemark-accuracy-map/results/ and copying the heat maps to
+# bench/accuracy_map/results/ and copying the heat maps to
 # docs/images/. About 15 minutes on 2 cores; `--quick` runs a small map into
 # a scratch folder instead.
 #
@@ -14,11 +14,11 @@
 # runs, instead of the above, the calibration tool and the accuracy map
 # once per preset (codemark's renders through that camera; AprilTag's keep
 # noise 2 and blur 0.8) and writes
-# apps/codemark-accuracy-map/results/presets/NAME/ (summary.txt, cells.csv,
+# bench/accuracy_map/results/presets/NAME/ (summary.txt, cells.csv,
 # heat maps, calibration.txt); --renders sets the map's renders per cell
 # (default 4); --renderer povray renders the map's frames with POV-Ray
 # (docs/povray.md; cached, so the other presets reuse the first one's
-# renders) into apps/codemark-accuracy-map/results/presets-povray/NAME/
+# renders) into bench/accuracy_map/results/presets-povray/NAME/
 # (the map only: the calibration tool renders with the project's renderer).
 # Environment: BUILD_DIR (default build-bench).
 set -euo pipefail
@@ -41,18 +41,18 @@ done
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCODEMARK_BUILD_BENCH=ON >/dev/null
 cmake --build "$build_dir" -j"$(nproc)" --target codemark-bench-pose-calib codemark-accuracy-map codemark-uncertainty
 calib="$build_dir/bench/pose_calib/codemark-bench-pose-calib"
-map="$build_dir/apps/codemark-accuracy-map/codemark-accuracy-map"
+map="$build_dir/bench/accuracy_map/codemark-accuracy-map"
 if [[ -n "$presets" ]]; then
   IFS=',' read -r -a names <<<"$presets"
   for p in "${names[@]}"; do
     if [[ "$renderer" == povray ]]; then
-      dir="apps/codemark-accuracy-map/results/presets-povray/$p"
+      dir="bench/accuracy_map/results/presets-povray/$p"
       mkdir -p "$dir"
       echo "== preset $p: accuracy map rendered by POV-Ray ($renders renders a cell)"
       "$map" --out "$dir" --renders "$renders" --preset "$p" --renderer povray
       continue
     fi
-    dir="apps/codemark-accuracy-map/results/presets/$p"
+    dir="bench/accuracy_map/results/presets/$p"
     mkdir -p "$dir"
     echo "== preset $p: C_P calibration data (realistic scenes) and accuracy map ($renders renders a cell)"
     "$calib" --renders 1200 --seed 7 --realistic --preset "$p" --max-bearing 0.35 --max-height 0.5 \
@@ -73,12 +73,12 @@ echo "== C_P calibration (realistic scenes, clipped sides apart)"
 echo "== C_P calibration (the accuracy map's flat background: its C_P, calibration plain)"
 "$calib" --renders 3000 --seed 7 --uniform-distance --noise-split 4
 echo "== accuracy map"
-"$map" --out apps/codemark-accuracy-map/results --renders 10
+"$map" --out bench/accuracy_map/results --renders 10
 echo "== accuracy map with the shipped C_P of the textured, lit scenes (for comparison)"
-"$map" --out apps/codemark-accuracy-map/results/realistic-calibration --renders 10 --no-apriltag --calibration realistic
+"$map" --out bench/accuracy_map/results/realistic-calibration --renders 10 --no-apriltag --calibration realistic
 "$build_dir/apps/codemark-uncertainty/codemark-uncertainty" --out apps/codemark-uncertainty/results/fig3.png
 mkdir -p docs/images
 for f in heat_l2 heat_phi2 heat_x heat_y; do
-  cp "apps/codemark-accuracy-map/results/$f.png" "docs/images/accuracy-$f.png"
+  cp "bench/accuracy_map/results/$f.png" "docs/images/accuracy-$f.png"
 done
 cp apps/codemark-uncertainty/results/fig3.png docs/images/uncertainty-fig3.png
