@@ -112,7 +112,7 @@ void drawErrorPanel(
 		cv::line(img, px(t0, k * tick), px(t1, k * tick), cv::Scalar(225, 225, 225));
 		cv::putText(
 			img, fmt(k * tick * 100, tick < 0.01 ? 2 : 1) + " cm",
-			px(t0, k * tick) + cv::Point(3, -2), cv::FONT_HERSHEY_SIMPLEX, 0.35,
+			cv::Point(box.x - 52, px(t0, k * tick).y + 4), cv::FONT_HERSHEY_SIMPLEX, 0.35,
 			cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
 	}
 	// Vertical grid: every 5 s (every 30 s on long runs), labelled.
@@ -121,8 +121,8 @@ void drawErrorPanel(
 	{
 		cv::line(img, px(t0 + t, 0), px(t0 + t, ymax), cv::Scalar(235, 235, 235));
 		cv::putText(
-			img, fmt(t, 0) + " s", px(t0 + t, 0) + cv::Point(2, -3), cv::FONT_HERSHEY_SIMPLEX, 0.33,
-			cv::Scalar(140, 140, 140), 1, cv::LINE_AA);
+			img, fmt(t, 0) + " s", px(t0 + t, 0) + cv::Point(-8, 12), cv::FONT_HERSHEY_SIMPLEX,
+			0.33, cv::Scalar(140, 140, 140), 1, cv::LINE_AA);
 	}
 	std::vector<cv::Point> err, bound;
 	for (const auto& row : r.summary.rows)
@@ -170,13 +170,13 @@ void drawNisPanel(
 	{
 		cv::line(img, px(t0, v), px(t1, v), cv::Scalar(225, 225, 225));
 		cv::putText(
-			img, fmt(v, v < 0.1 ? 2 : (v < 1 ? 1 : 0)), px(t1, v) + cv::Point(-32, -3),
+			img, fmt(v, v < 0.1 ? 2 : (v < 1 ? 1 : 0)), cv::Point(box.x - 40, px(t0, v).y + 4),
 			cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
 	}
 	const double every_s = t1 - t0 > 120 ? 30 : 5;
 	for (double t = every_s; t < t1 - t0; t += every_s)
 		cv::putText(
-			img, fmt(t, 0) + " s", px(t0 + t, lo) + cv::Point(2, -3), cv::FONT_HERSHEY_SIMPLEX,
+			img, fmt(t, 0) + " s", px(t0 + t, lo) + cv::Point(-8, 12), cv::FONT_HERSHEY_SIMPLEX,
 			0.33, cv::Scalar(140, 140, 140), 1, cv::LINE_AA);
 	std::vector<std::pair<double, double>> points;	// time, NIS / DoF
 	for (const auto& row : r.summary.rows)
@@ -237,7 +237,7 @@ std::vector<std::string> writeDatasetPlots(
 		return std::max(0.005, 1.2 * values[static_cast<std::size_t>(0.95 * (values.size() - 1))]);
 	};
 	// Each panel: a label line above its box.
-	const int W = 900, ph = 150, margin = 28, top = 45;
+	const int W = 900, ph = 150, margin = 34, top = 45;
 	cv::Mat img(
 		top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3, cv::Scalar(255, 255, 255));
 	cv::putText(
@@ -247,7 +247,7 @@ std::vector<std::string> writeDatasetPlots(
 		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	for (std::size_t k = 0; k < ok.size(); ++k)
 		drawErrorPanel(
-			img, cv::Rect(10, top + static_cast<int>(k) * (ph + margin), W - 20, ph), *ok[k], t0,
+			img, cv::Rect(60, top + static_cast<int>(k) * (ph + margin), W - 70, ph), *ok[k], t0,
 			t1, scaleOf(*ok[k]), kMethodColours[k % 6]);
 	const std::string err_file = name + "-error.png";
 	if (!cv::imwrite(dir + "/" + err_file, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
@@ -264,7 +264,7 @@ std::vector<std::string> writeDatasetPlots(
 		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	for (std::size_t k = 0; k < ok.size(); ++k)
 		drawNisPanel(
-			nis, cv::Rect(10, top + static_cast<int>(k) * (ph + margin), W - 20, ph), *ok[k], t0,
+			nis, cv::Rect(60, top + static_cast<int>(k) * (ph + margin), W - 70, ph), *ok[k], t0,
 			t1, kMethodColours[k % 6]);
 	const std::string nis_file = name + "-nis.png";
 	if (!cv::imwrite(dir + "/" + nis_file, nis, {cv::IMWRITE_PNG_COMPRESSION, 9}))

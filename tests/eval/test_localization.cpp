@@ -3,6 +3,8 @@
 #include <codemark/eval/ground_truth.h>
 #include <codemark/eval/localization.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <nlohmann/json.hpp>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -169,9 +171,18 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 	ASSERT_TRUE(s.metrics);
 	EXPECT_LT(s.metrics->ate_rmse_m, 0.02);
 	for (const char* f :
-		 {"estimated_path.txt", "estimated_path.tum", "covariances.txt", "trajectory.png",
-		  "trajectory.3Dscene", "summary.json"})
+		 {"estimated_path.txt", "estimated_path.tum", "covariances.txt", "innovations.txt",
+		  "trajectory.png", "trajectory.3Dscene", "summary.json"})
+	{
 		EXPECT_TRUE(fs::exists(fs::path(req.out_dir) / f)) << f;
+		EXPECT_GT(fs::file_size(fs::path(req.out_dir) / f), 100u) << f;
+	}
+	// The plot: an image with drawn content, not a blank canvas.
+	const cv::Mat plot = cv::imread((fs::path(req.out_dir) / "trajectory.png").string());
+	ASSERT_FALSE(plot.empty());
+	cv::Mat grey;
+	cv::cvtColor(plot, grey, cv::COLOR_BGR2GRAY);
+	EXPECT_GT(cv::countNonZero(grey < 128), 1000) << "lines, labels and the path";
 	std::ifstream path(fs::path(req.out_dir) / "estimated_path.txt");
 	std::string line;
 	std::getline(path, line);

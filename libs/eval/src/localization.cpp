@@ -200,18 +200,39 @@ void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::stri
 	if (x0 > x1) x0 = y0 = -1, x1 = y1 = 1;
 	const double margin = 0.5;
 	x0 -= margin, y0 -= margin, x1 += margin, y1 += margin;
-	const int W = 1000;
-	const double scale = W / std::max(x1 - x0, 1e-3);
-	const int H = std::clamp(static_cast<int>((y1 - y0) * scale), 100, 4000);
-	cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
-	auto px = [&](double x, double y) {
+	// The plot area, with margins for the title (top) and the axes' labels
+	// (left, bottom), so that no label lies over the data.
+	const int W = 1000, left = 45, right = 10, top = 30, bottom = 30;
+	const double scale = (W - left - right) / std::max(x1 - x0, 1e-3);
+	const int plot_h = std::clamp(static_cast<int>((y1 - y0) * scale), 100, 4000);
+	cv::Mat img(plot_h + top + bottom, W, CV_8UC3, cv::Scalar(255, 255, 255));
+	auto px = [&](double x, double y)
+	{
 		return cv::Point(
-			static_cast<int>((x - x0) * scale), static_cast<int>(H - (y - y0) * scale));
+			left + static_cast<int>((x - x0) * scale),
+			top + plot_h - static_cast<int>((y - y0) * scale));
 	};
+	const cv::Scalar grid(230, 230, 230), label(110, 110, 110);
 	for (int g = static_cast<int>(std::ceil(x0)); g <= x1; ++g)
-		cv::line(img, px(g, y0), px(g, y1), cv::Scalar(230, 230, 230));
+	{
+		cv::line(img, px(g, y0), px(g, y1), grid);
+		cv::putText(
+			img, std::to_string(g), cv::Point(px(g, y0).x - 4, top + plot_h + 15),
+			cv::FONT_HERSHEY_SIMPLEX, 0.4, label, 1, cv::LINE_AA);
+	}
 	for (int g = static_cast<int>(std::ceil(y0)); g <= y1; ++g)
-		cv::line(img, px(x0, g), px(x1, g), cv::Scalar(230, 230, 230));
+	{
+		cv::line(img, px(x0, g), px(x1, g), grid);
+		cv::putText(
+			img, std::to_string(g), cv::Point(8, px(x0, g).y + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+			label, 1, cv::LINE_AA);
+	}
+	cv::rectangle(img, px(x0, y1), px(x1, y0), cv::Scalar(150, 150, 150));
+	cv::putText(
+		img, "x [m]", cv::Point(W - right - 40, top + plot_h + 26), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+		label, 1, cv::LINE_AA);
+	cv::putText(
+		img, "y [m]", cv::Point(4, top - 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, label, 1, cv::LINE_AA);
 	auto drawLandmark = [&](const MapLandmark& l, const cv::Scalar& c)
 	{
 		cv::circle(img, px(l.x_m, l.y_m), 4, c, cv::FILLED, cv::LINE_AA);
@@ -251,8 +272,10 @@ void writePlot(const LocalizeSummary& s, const LandmarkMap& map, const std::stri
 			cv::LINE_AA);
 	}
 	cv::putText(
-		img, s.method + ": estimate (blue), ground truth (green), 95% ellipses (red), 1 m grid",
-		cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+		img,
+		s.method + ": estimate (blue), ground truth (green), 95% ellipses (red), map landmarks " +
+			"(black, with their normals)" + (s.slam_map.empty() ? "" : ", mapped (purple)"),
+		cv::Point(left, 18), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
 	if (!cv::imwrite(file, img)) throw std::runtime_error(file + ": cannot write");
 }
 
