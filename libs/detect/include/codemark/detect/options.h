@@ -162,10 +162,9 @@ struct SubpixelParams
 	 * censored noise distribution, or where all of the fill clips from an
 	 * edge model of B, G and R fitted with them censored) before the edges
 	 * are read: the clip cuts the bright half of the response, which moves
-	 * each edge outwards by 0.012 px where only a fill's noise clips,
-	 * 0.05 px at gains of 1.1-1.6 and up to 0.5 px on thin frames. A fill
-	 * at exactly the top clips half of them through its noise; a JPEG's
-	 * ringing next to an unclipped fill a few. */
+	 * each edge outwards, further as more of the fill clips and as the frame
+	 * thins. A fill at exactly the top clips half of them through its noise;
+	 * a JPEG's ringing next to an unclipped fill a few. */
 	double clipped_fraction = 0.25;
 	/** Where the black frame is narrower than this across a side [px], its
 	 * outer edge overlaps the inner edge's response: the edge is then taken
@@ -209,8 +208,8 @@ struct CodeParams
 	 * darkest sides) may exceed the black cells' mean G by at most this
 	 * fraction of the fill's G above that mean. Independent of the
 	 * camera's transfer curve, which maps equal levels to equal levels.
-	 * Landmarks read up to 0.25 through every camera preset, where a thin
-	 * frame blurs towards the fill; a grey surround reads 0.5. */
+	 * A thin frame that blurs towards the fill raises it a little; a grey
+	 * surround, another ink than the cells', raises it far more. */
 	double max_frame_cell_ratio = 0.35;
 	/** Each cell's distance to the threshold must be at least this fraction
 	 * of the contrast (else ambiguous: rejected). */

@@ -129,7 +129,7 @@ struct LocalizeSummary
 	double detect_ms_per_image = 0;	 //!< mean on-the-fly detection time [ms] (0: none)
 	std::optional<PathMetrics> metrics;	 //!< with ground truth
 	std::vector<PathRow> rows;
-	std::vector<filters::MappedLandmark> slam_map;  //!< SLAM only
+	std::vector<filters::MappedLandmark> slam_map;	//!< SLAM only
 };
 
 /** Sets \a s's NIS fields (nis_mean, nis_dof, nis_count, gated_fraction,
@@ -148,7 +148,8 @@ std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool
  * by ID, through \a m's truth_T_estimate (identity when not aligned). The
  * yaw error means nothing for point landmarks. */
 void addLandmarkErrors(
-	PathMetrics& m, const std::vector<filters::MappedLandmark>& estimated, const LandmarkMap& truth);
+	PathMetrics& m, const std::vector<filters::MappedLandmark>& estimated,
+	const LandmarkMap& truth);
 
 /** The SE(2) least-squares alignment b_T_a of 2D points \a a onto \a b
  * (pairs, at least one): closed form (Horn 1987 / Umeyama 1991 in the

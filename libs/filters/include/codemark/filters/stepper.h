@@ -44,10 +44,9 @@ struct StepperOptions : public mrpt::config::CLoadableOptions
 	 * filter sees them [deg]: the angle between the line of sight and the
 	 * landmark's normal, |phi1 + phi2| (docs/spec.md section 4). The
 	 * detector and the closed form are validated up to 60 deg (the
-	 * render tests); beyond it the measured range is biased short (2-3 cm,
-	 * 2 sigma, at 73 deg and 4 m in codemark-simul's default room), a
-	 * systematic error that C_L does not describe and that made the filters
-	 * overconfident. >= 90 keeps everything. */
+	 * render tests); beyond it the measured range is biased short, a
+	 * systematic error that C_L does not describe and that makes the filters
+	 * overconfident. >= 90 keeps everything. ini key `max_view_angle_deg`. */
 	double max_view_angle_deg = 60.0;
 	/** Measure the sightings of annotated rawlogs again (their stored
 	 * corners, quality and camera, the pipeline options' C_P, the map's

@@ -103,7 +103,7 @@ cv::Mat imageAsBgr(const mrpt::obs::CObservationImage& img, const std::string& i
 /** `<dir>/<name without extension>_Images` for a rawlog path: MRPT's
  * external-image folder. Computed here because MRPT 2.5.8's
  * CRawlog::detectImagesDirectory drops the slash for paths with a
- * directory part (MRPT 2.5.8). */
+ * directory part. */
 std::string imagesDirectoryOf(const std::string& rawlog_path);
 
 }  // namespace codemark::pipeline

@@ -8,11 +8,11 @@
  * phi1 + phi2 -> -(phi1 + phi2)): both fit the corners, and a bias of a
  * few hundredths of a pixel decides which is the least-squares optimum (the
  * planar-pose ambiguity that IPPE returns as two solutions). The local,
- * first-order covariance of the chosen mode knows nothing of the other: on
- * the accuracy map at 4.5 m seen nearly squarely it reported phi2 within
- * 1.5 deg of a truth 12 deg away (NEES in the thousands,
- * docs/benchmarks/pose.md). Here the two modes are weighed by Laplace's
- * approximation of their probability mass, and the reported covariance is
+ * first-order covariance of the chosen mode knows nothing of the other, so
+ * when the wrong mode wins it can report phi2 tightly about a value many of
+ * its own sigmas from the truth (see docs/benchmarks/pose.md). Here the two
+ * modes are weighed by Laplace's approximation of their probability mass,
+ * and the reported covariance is
  * the mean squared error about the best-fitting mode over both: the
  * smallest covariance that stays honest whichever mode is true.
  */

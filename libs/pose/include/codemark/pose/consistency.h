@@ -6,10 +6,9 @@
  * holds for N independent sightings. The accuracy map's are not: the renders
  * of one cell share its geometry, and with it the detector's systematic
  * error there (a thin frame's bias, a pixel phase), so their errors move
- * together and the mean wanders far more than the band allows (on the map
- * from 2 to 5 m the variance of the mean NEES is 7-9 times the independent
- * one). With the clusters as the independent units, the mean's standard
- * error comes from the spread of the clusters' sums (the cluster-robust,
+ * together and the mean wanders far more than the band allows. With the
+ * clusters as the independent units, the mean's standard error comes from
+ * the spread of the clusters' sums (the cluster-robust,
  * "sandwich" variance of a ratio mean), and its interval from Student's t
  * with (clusters - 1) degrees of freedom.
  */

@@ -102,14 +102,15 @@ GeneralPose solveGeneralPose(
  * and each edge's tilt (t1, t2: half the x difference of its ends). These
  * get independent variances \a midpoint_ratio^2 var(y_i) and \a tilt_ratio^2
  * var(x_i); ratios of 1 are independent corners of equal noise (the spec's
- * isotropic model), codemark's detector measures 0.8 and 0.25 (its edge
- * errors are mostly shifts of whole lines: pipeline.h). Mapped to raw
- * pixels through the distortion's Jacobian; \a tilt_extra_var is added to
- * the tilts' variances (PoseOptions::corner_tilt_noise_ratio; the sum is
- * kept at least 0). It lets the general path use
- * the closed form's correlated edge noise, which one isotropic corner sigma
- * cannot carry (a common shift of x1 and x2 is far less certain than their
- * difference, which range and phi2 use). */
+ * isotropic model); codemark's detector's are below 1 (its edge errors are
+ * mostly shifts of whole lines; the calibration sets them,
+ * PoseOptions::corner_midpoint_ratio). Mapped to raw pixels through the
+ * distortion's Jacobian; \a tilt_extra_var is added to the tilts'
+ * variances (PoseOptions::corner_tilt_noise_ratio; the sum is kept at least
+ * 0). It lets the general path use the closed form's correlated edge
+ * noise, which one isotropic corner sigma cannot carry (a common shift of
+ * x1 and x2 is far less certain than their difference, which range and
+ * phi2 use). */
 CornerCovariance cornerCovarianceFromPrimary(
 	const std::array<Eigen::Vector2d, 4>& corners_raw_px, const CameraModel& camera,
 	const Eigen::Matrix4d& C_P, double midpoint_ratio = 1.0, double tilt_ratio = 1.0,

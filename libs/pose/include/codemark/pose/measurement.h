@@ -96,12 +96,11 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** Growth of the noise of x1, x2 as the landmark shrinks in the image
 	 * [px]: sigma_x(w) = sqrt(sigma_px^2 + (growth_x_px (size_reference_px /
 	 * w)^size_exponent_x)^2), w = x2 - x1 the apparent (foreshortened) width
-	 * [px]. 0: sigma_px at every size (the spec's constant C_P). A small
+	 * [px]. Default 0: sigma_px at every size (the spec's constant C_P). A small
 	 * landmark's black frame is a few pixels wide and its two edges blur
-	 * into each other, which moves the inner edges (measured by
-	 * codemark-bench-pose-calib, docs/benchmarks/pose.md). */
+	 * into each other, which moves the inner edges. */
 	double growth_x_px = 0;
-	/** The same for y1, y2 with h = y1 + y2 the apparent height [px]. */
+	/** The same for y1, y2 with h = y1 + y2 the apparent height [px]. Default 0. */
 	double growth_y_px = 0;
 	/** When not empty: sigma(x1) = sigma(x2) tabulated against the apparent
 	 * width w = x2 - x1 (interpolateSigma()), in place of sigma_px and the
@@ -109,7 +108,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * detector's error against size need not follow one power law (a thin
 	 * frame's edges pull on each other below about 7 px, noise alone
 	 * falls as 1 / sqrt(edge length)): codemark-bench-pose-calib measures the
-	 * table. ini key `sigma_x_table` = "size:sigma size:sigma ...". */
+	 * table. Default empty. ini key `sigma_x_table` = "size:sigma size:sigma ...". */
 	SigmaTable sigma_x_table;
 	/** The same for y1, y2 against the apparent height h = y1 + y2, with
 	 * corr_growth_y12. ini key `sigma_y_table`. */
@@ -118,7 +117,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double size_exponent_y = 2;	 //!< exponent of the growth of y1, y2 (see growth_x_px)
 	double size_reference_px =
 		30;	 //!< apparent size at which the growth term equals growth_*_px [px]
-	/** Correlation coefficient (-1..1) of the errors of x1 and x2 in the
+	/** Correlation coefficient, in (-1, 1), of the errors of x1 and x2 in the
 	 * constant (sigma_px) part of their noise. Negative: the two inner
 	 * vertical edges move apart or together (the square's apparent width,
 	 * which phi2 uses at oblique views, is then worse than independent
@@ -126,7 +125,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double corr_x12 = 0;
 	/** The same for the size-dependent (growth_x_px) part. */
 	double corr_growth_x12 = 0;
-	/** Correlation coefficient (-1..1) of the errors of y1 and y2 in the
+	/** Correlation coefficient, in (-1, 1), of the errors of y1 and y2 in the
 	 * constant (sigma_y_px) part; positive: both half-lengths grow or shrink
 	 * together (a range error, not a phi2 error). */
 	double corr_y12 = 0;
@@ -143,12 +142,11 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double corner_tilt_ratio = 1.0;	 //!< see corner_midpoint_ratio
 	/** corner_tilt_ratio tabulated against the apparent height y1 + y2 (the
 	 * vertical edges' length) [px], interpolated as the sigma tables; when
-	 * not empty, in place of corner_tilt_ratio. The detector's tilt ratio is
-	 * no constant: far (edges under about 50 px) its line fits err by
-	 * shifts of whole lines and the ratio reads 0.3-0.4, near (over 65 px)
-	 * 0.85-0.9 (codemark-bench-pose-calib): the one ratio made the general
-	 * path overconfident within 2 m and pessimistic beyond. ini key
-	 * `corner_tilt_ratio_table` = "size:ratio size:ratio ...". */
+	 * not empty, in place of corner_tilt_ratio. The detector's tilt ratio
+	 * depends on the edges' length: on short edges its line fits err mostly
+	 * by shifts of whole lines (a small ratio), on long ones the ratio nears
+	 * 1, so one constant ratio cannot fit every distance. Default empty. ini
+	 * key `corner_tilt_ratio_table` = "size:ratio size:ratio ...". */
 	SigmaTable corner_tilt_ratio_table;
 	/** corner_tilt_ratio, or its table's value at apparent height \a height_px. */
 	double cornerTiltRatio(double height_px) const;
@@ -158,22 +156,22 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * var_ref(x_i) + corner_tilt_noise_ratio^2 (var(x_i) - var_ref(x_i)), r
 	 * the tilt ratio (cornerTiltRatio()). A tilt gains more from the noise
 	 * than from the detector's bias, which shifts whole lines (a line fit's
-	 * slope takes 3x the variance of its offset at the ends). 0: r for both
-	 * parts. ini key `corner_tilt_noise_ratio`. */
+	 * slope takes 3x the variance of its offset at the ends). Default 0: r
+	 * for both parts. ini key `corner_tilt_noise_ratio`. */
 	double corner_tilt_noise_ratio = 0;
 	/** Standard deviation added to the edge of each side whose green fill
 	 * clipped throughout (DetectionQuality::fill_clipped) [px]: its edge
-	 * rests on the dark half of the transition alone, 2-5x less certain than
-	 * an unclipped one within 2 m (docs/benchmarks/pose.md). A left or right
+	 * rests on the dark half of the transition alone and is less certain than
+	 * an unclipped one (see docs/benchmarks/pose.md). A left or right
 	 * side adds it to x1 or x2; a top or bottom side moves both half-lengths
 	 * by half its shift (y1, y2 fully correlated). Applied by
 	 * measure(const Detection&, ...) only (a prediction cannot know the
-	 * light). 0: off. ini key `clipped_side_sigma_px`. */
+	 * light). Default 0: off. ini key `clipped_side_sigma_px`. */
 	double clipped_side_sigma_px = 0;
-	/** Correlation (0..1) of the outward shifts of two clipped sides: the
+	/** Correlation, in [0, 1), of the outward shifts of two clipped sides: the
 	 * edge model's fill level, which places every clipped edge, errs for all
 	 * of them at once, so a landmark clipped all round looks larger or
-	 * smaller as a whole (a range error). ini key
+	 * smaller as a whole (a range error). Default 0. ini key
 	 * `clipped_side_correlation`. */
 	double clipped_side_correlation = 0;
 	/** The part of C_P that clipped sides add (see clipped_side_sigma_px),
@@ -187,7 +185,7 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * aligned_edge_ratio sigma_y(h) (1 - rows), rows the ends' difference
 	 * [px] (0 beyond one row), shared by y1 and y2 as a clipped side's.
 	 * (Vertical edges of a level camera always run along a pixel column:
-	 * the calibration's x model holds that.) 0: off. ini key
+	 * the calibration's x model holds that.) Default 0: off. ini key
 	 * `aligned_edge_ratio`. */
 	double aligned_edge_ratio = 0;
 	/** The part of C_P that aligned top and bottom edges add (see
@@ -248,28 +246,27 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	/** Closed form: refine L by weighted least squares on P with C_P
 	 * (refineLandmarkOnPrimary(): the paper's formulas use P's four numbers
 	 * unweighted for three unknowns and waste the foreshortened width, which
-	 * carries most of phi2 at oblique views; about 5-10x smaller phi2 errors
-	 * at 3-5 m, docs/benchmarks/pose.md), C_L from the Fisher information.
-	 * Still P alone. ini key `refine_on_primary`. */
+	 * carries most of phi2 at oblique views; see docs/benchmarks/pose.md),
+	 * C_L from the Fisher information. Still P alone. Default on. ini key
+	 * `refine_on_primary`. */
 	bool refine_on_primary = true;
 	/** Weigh the measurement's second local optimum, the landmark's mirror
 	 * image about the line of sight (view angle phi1 + phi2 -> -(phi1 +
 	 * phi2), IPPE's second solution on the general path), against the first
 	 * and report the better fit (the lower chi2 on the closed form, IPPE's
 	 * lower reprojection error on the general path) with the mean squared
-	 * error over both as C_L and C_R (foldModes(), ambiguity.h). Far and near-frontal the
-	 * two fit the corners almost equally, and the local covariance alone
-	 * put phi2 within 1.5 deg of a truth 12 deg away (docs/benchmarks/pose.md).
-	 * Closed form refined on P (refine_on_primary) and general path. On by
-	 * default: one sighting's C_L and C_R are then honest on their own (the
-	 * accuracy map from 2 to 5 m at noise 2, 40 renders a cell: closed form
-	 * mean NEES 2.81 folded against 6.04 unfolded). The shipped EKF configs
-	 * turn it off: a filter fuses the same far landmark frame after frame,
-	 * whose mirror image wins or loses by the same detector bias each time,
-	 * and there the fold makes the loops' NEES 4% low (ekf.ini). ini key
-	 * `fold_ambiguity`. */
+	 * error over both as C_L and C_R (foldModes(), ambiguity.h). Far and
+	 * near-frontal the two fit the corners almost equally, and the local
+	 * covariance of one alone can exclude the true phi2 by far more than its
+	 * width. Closed form refined on P (refine_on_primary) and general path.
+	 * On by default: one sighting's C_L and C_R are then honest on their own.
+	 * The shipped EKF configs turn it off: a filter fuses the same far
+	 * landmark frame after frame, whose mirror image wins or loses by the same
+	 * detector bias each time, so the widening of every frame adds up to a
+	 * pessimistic filter (ekf.ini). ini key `fold_ambiguity`. */
 	bool fold_ambiguity = true;
-	/** General path: Levenberg-Marquardt iterations of each refinement. */
+	/** General path: the most Levenberg-Marquardt iterations of each
+	 * refinement. ini key `lm_max_iterations`. */
 	int lm_max_iterations = 30;
 
 	/** Throws std::invalid_argument on a non-positive sigma or iteration count. */
