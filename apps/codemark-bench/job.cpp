@@ -33,25 +33,6 @@ double seconds(Clock::time_point a, Clock::time_point b)
 	return std::chrono::duration<double>(b - a).count();
 }
 
-// [localize] initial pose, as codemark-localize reads it
-// (filters/src/outputs.cpp keeps its reader private).
-std::optional<filters::PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg)
-{
-	if (!cfg.read_bool("localize", "initial_pose_known", false)) return std::nullopt;
-	filters::PoseEstimate e;
-	e.initialized = true;
-	e.mean = CPose2D(
-		cfg.read_double("localize", "initial_x", 0), cfg.read_double("localize", "initial_y", 0),
-		mrpt::DEG2RAD(cfg.read_double("localize", "initial_yaw_deg", 0)));
-	const double sxy = cfg.read_double("localize", "initial_std_xy", 0.1);
-	const double syaw = mrpt::DEG2RAD(cfg.read_double("localize", "initial_std_yaw_deg", 5.0));
-	if (!(sxy > 0) || !(syaw > 0))
-		throw std::invalid_argument(
-			"[localize] initial_std_xy and initial_std_yaw_deg must be > 0");
-	e.cov = Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
-	return e;
-}
-
 // Compares one frame's landmark observation with what the true pose shows.
 void tallyDetections(
 	const CObservationCodedLandmarks& obs, const CPose2D& truth, const LandmarkMap& map,
@@ -190,7 +171,7 @@ JobResult runJob(
 		// ekf-slam builds its own map: the dataset's map is its ground truth
 		// (for the plots and the detection rate), not a prior.
 		const LandmarkMap prior = method == "ekf-slam" ? LandmarkMap() : map;
-		auto filter = filters::makeLocalizer(method, mcfg, prior, initialPose(mcfg));
+		auto filter = filters::makeLocalizer(method, mcfg, prior, filters::initialPose(mcfg));
 		filters::RawlogStepper stepper(ds.rawlog, so, po);
 		filters::RawlogStep step;
 		double filter_s = 0, detect_s = 0, first_t = 0;

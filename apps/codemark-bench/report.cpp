@@ -7,6 +7,7 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -236,40 +237,39 @@ std::vector<std::string> writeDatasetPlots(
 		std::sort(values.begin(), values.end());
 		return std::max(0.005, 1.2 * values[static_cast<std::size_t>(0.95 * (values.size() - 1))]);
 	};
-	// Each panel: a label line above its box.
-	const int W = 900, ph = 150, margin = 34, top = 45;
-	cv::Mat img(
-		top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3, cv::Scalar(255, 255, 255));
-	cv::putText(
-		img,
-		name + ": position error against time [" + fmt(t1 - t0, 0) +
+	// A figure of one panel per method, each with a label line above its
+	// box and its ticks' labels in the margins.
+	const auto writePanels =
+		[&](const std::string& suffix, const std::string& title,
+			const std::function<void(cv::Mat&, const cv::Rect&, std::size_t)>& draw)
+	{
+		const int W = 900, ph = 150, margin = 34, top = 45;
+		cv::Mat img(
+			top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3,
+			cv::Scalar(255, 255, 255));
+		cv::putText(
+			img, name + ": " + title, cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42,
+			cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+		for (std::size_t k = 0; k < ok.size(); ++k)
+			draw(img, cv::Rect(60, top + static_cast<int>(k) * (ph + margin), W - 70, ph), k);
+		const std::string file = name + suffix;
+		if (!cv::imwrite(dir + "/" + file, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
+			throw std::runtime_error(dir + "/" + file + ": cannot write");
+		files.push_back(file);
+	};
+	writePanels(
+		"-error.png",
+		"position error against time [" + fmt(t1 - t0, 0) +
 			" s], 3-sigma = 3 sqrt(largest eigenvalue of the xy covariance)",
-		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-	for (std::size_t k = 0; k < ok.size(); ++k)
-		drawErrorPanel(
-			img, cv::Rect(60, top + static_cast<int>(k) * (ph + margin), W - 70, ph), *ok[k], t0,
-			t1, scaleOf(*ok[k]), kMethodColours[k % 6]);
-	const std::string err_file = name + "-error.png";
-	if (!cv::imwrite(dir + "/" + err_file, img, {cv::IMWRITE_PNG_COMPRESSION, 9}))
-		throw std::runtime_error(dir + "/" + err_file + ": cannot write");
-	files.push_back(err_file);
-
-	// Innovation consistency against time, one panel per method.
-	cv::Mat nis(
-		top + static_cast<int>(ok.size()) * (ph + margin), W, CV_8UC3, cv::Scalar(255, 255, 255));
-	cv::putText(
-		nis,
-		name + ": NIS / DoF against time [" + fmt(t1 - t0, 0) +
+		[&](cv::Mat& img, const cv::Rect& box, std::size_t k)
+		{ drawErrorPanel(img, box, *ok[k], t0, t1, scaleOf(*ok[k]), kMethodColours[k % 6]); });
+	// Innovation consistency against time.
+	writePanels(
+		"-nis.png",
+		"NIS / DoF against time [" + fmt(t1 - t0, 0) +
 			" s], log scale; green: the band [0.5, 2] of a consistent mean",
-		cv::Point(10, 17), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-	for (std::size_t k = 0; k < ok.size(); ++k)
-		drawNisPanel(
-			nis, cv::Rect(60, top + static_cast<int>(k) * (ph + margin), W - 70, ph), *ok[k], t0,
-			t1, kMethodColours[k % 6]);
-	const std::string nis_file = name + "-nis.png";
-	if (!cv::imwrite(dir + "/" + nis_file, nis, {cv::IMWRITE_PNG_COMPRESSION, 9}))
-		throw std::runtime_error(dir + "/" + nis_file + ": cannot write");
-	files.push_back(nis_file);
+		[&](cv::Mat& img, const cv::Rect& box, std::size_t k)
+		{ drawNisPanel(img, box, *ok[k], t0, t1, kMethodColours[k % 6]); });
 
 	// Trajectories: ground truth, every method, the landmarks.
 	const LandmarkMap map = filters::isMrptLandmarksFile(map_file)
