@@ -3,6 +3,7 @@
  * anything is printed or imaged (paper section 3, Fig. 3). Parses the
  * command line and calls codemark::pose (uncertainty.h).
  */
+#include <codemark/eval/uncertainty_figure.h>
 #include <codemark/pose/uncertainty.h>
 #include "calibration.h"
 
@@ -152,7 +153,7 @@ int main(int argc, char** argv)
 		}
 		if (out_arg.isSet() || !did)
 		{
-			cp::FigureOptions fo;
+			codemark::eval::FigureOptions fo;
 			fo.sigma_px = sigma;
 			if (calibration_arg.isSet())
 			{
@@ -165,7 +166,8 @@ int main(int argc, char** argv)
 			fo.heading_magnification = hmag_arg.getValue();
 			fo.min_size_px = min_size_arg.getValue();
 			const std::string path = out_arg.isSet() ? out_arg.getValue() : "uncertainty.png";
-			const cp::FigureScales mag = cp::drawUncertaintyFigure(path, camera, fo);
+			const codemark::eval::FigureScales mag =
+				codemark::eval::drawUncertaintyFigure(path, camera, fo);
 			std::cout << "wrote " << path << " (ellipses drawn x" << mag.ellipse
 					  << ", heading wedges x" << mag.heading << ")\n";
 		}

@@ -1,5 +1,5 @@
 // Uncertainty before printing: predictUncertainty against measure(), the
-// scale advice, the accuracy table and the Fig. 3 file.
+// scale advice and the accuracy table.
 #include <codemark/landmark/truth.h>
 #include <codemark/pose/uncertainty.h>
 #include <gtest/gtest.h>
@@ -68,30 +68,10 @@ TEST(Uncertainty, SizeForMeetsTheRequestMinimally)
 	EXPECT_THROW(sizeFor(cam, 0.05, -1, 0.1, 2, 0), std::invalid_argument);
 }
 
-TEST(Uncertainty, TableAndFigure)
+TEST(Uncertainty, Table)
 {
 	const CameraModel cam;
 	const std::string t = accuracyTable(cam, 1.0, 0.05, 0.0, {0.5, 1.0, 4.5});
 	EXPECT_NE(t.find("yes"), std::string::npos);
 	EXPECT_NE(t.find("too small"), std::string::npos);	// 4.5 m: 28 px
-	const std::string path =
-		(std::filesystem::temp_directory_path() / "codemark_test_fig3.png").string();
-	FigureOptions fo;
-	const FigureScales sc = drawUncertaintyFigure(path, cam, fo);
-	EXPECT_GT(sc.ellipse, 0);
-	EXPECT_GE(sc.heading, 1);
-	const cv::Mat img = cv::imread(path);
-	ASSERT_FALSE(img.empty());
-	EXPECT_GE(img.cols, 640);
-	// Some red (ellipse) pixels were drawn.
-	int red = 0;
-	for (int r = 0; r < img.rows; ++r)
-		for (int c = 0; c < img.cols; ++c)
-		{
-			const auto p = img.at<cv::Vec3b>(r, c);
-			red += p[2] > 180 && p[1] < 100 && p[0] < 100;
-		}
-	EXPECT_GT(red, 100);
-	std::remove(path.c_str());
-	EXPECT_THROW(drawUncertaintyFigure("/nonexistent-dir/x.png", cam, fo), std::exception);
 }
