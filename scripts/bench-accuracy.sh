@@ -4,8 +4,8 @@
 # share/codemark/calibration/*.ini) and the accuracy map
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,
 # general 6-DoF path and AprilTag 3), writing
-# bench/accuracy_map/results/ and copying the heat maps to
-# docs/images/. About 15 minutes on 2 cores; `--quick` runs a small map into
+# bench/accuracy_map/results/, copying the heat maps to docs/images/ and
+# writing docs/benchmarks/pose.md (scripts/accuracy-report.py). About 15 minutes on 2 cores; `--quick` runs a small map into
 # a scratch folder instead.
 #
 # Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
@@ -82,3 +82,6 @@ for f in heat_l2 heat_phi2 heat_x heat_y; do
   cp "bench/accuracy_map/results/$f.png" "docs/images/accuracy-$f.png"
 done
 cp apps/codemark-uncertainty/results/fig3.png docs/images/uncertainty-fig3.png
+python3 scripts/accuracy-report.py scripts/bench-accuracy.sh bench/accuracy_map/results \
+  bench/accuracy_map/results/realistic-calibration >docs/benchmarks/pose.md
+echo "bench-accuracy.sh: wrote docs/benchmarks/pose.md" >&2
