@@ -1,6 +1,6 @@
 // codemark-localize: runs one filter (ekf, ekf-pose, ekf-slam, pf) over a
 // rawlog and writes the outputs of docs/spec.md section 6. The logic is
-// codemark::eval::runLocalization (libs/filters/src/outputs.cpp).
+// codemark::eval::runLocalization (libs/eval/src/localization.cpp).
 #include <codemark/eval/localization.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
