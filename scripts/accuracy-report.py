@@ -11,6 +11,7 @@ its notes a list.
 """
 import datetime
 import os
+import re
 import platform
 import subprocess
 import sys
@@ -31,7 +32,12 @@ def regions(path):
             if line.startswith("# "):
                 preamble.append(line[2:])
         elif line.startswith("metric"):
+            cur.append("worse" in line)
             continue
+        elif cur is not None and len(cur) == 4 and cur[3] and re.match(
+                r"^(\S+)\s+(\d+ \(\d+\))\s+(\d+ \(\d+\))\s+(\d+)$", line):
+            cur[1].append(list(re.match(
+                r"^(\S+)\s+(\d+ \(\d+\))\s+(\d+ \(\d+\))\s+(\d+)$", line).groups()))
         elif line.strip() and cur is not None and line[:1] != " " and "  " in line and \
                 not line.startswith(("pose NEES", "cells", "corner", "95%")):
             # "name [unit]   v1   v2   v3   v4" (trailing columns may be blank)
@@ -39,7 +45,7 @@ def regions(path):
             vals = line[20:].split()
             cur[1].append([name] + vals + [""] * (4 - len(vals)))
         elif line.strip():
-            cur[2].append(line.strip())
+            cur[2].append(line.strip().lstrip("# "))
     return preamble, out
 
 
@@ -63,12 +69,14 @@ def main():
     for p in preamble:
         print(p[0].upper() + p[1:] + ".")
     print()
-    for title, rows, notes in regs:
+    for title, rows, notes, *kind in regs:
         if not rows:
             continue
         print(f"## {title[0].upper() + title[1:]}")
         print()
-        print(table(rows, HEADERS))
+        per_cell = bool(kind and kind[0])
+        print(table(rows, ["metric", "cells where cf is worse than AprilTag (> 2 se)",
+                           "where gen is worse (> 2 se)", "cells"] if per_cell else HEADERS))
         print()
         for n in notes:
             print(f"- {n}")
@@ -80,8 +88,8 @@ def main():
         for p in pre:
             print(p[0].upper() + p[1:] + ".")
         print()
-        for title, rows, notes in regs:
-            if not rows:
+        for title, rows, notes, *kind in regs:
+            if not rows or (kind and kind[0]):
                 continue
             print(f"### {title[0].upper() + title[1:]}")
             print()

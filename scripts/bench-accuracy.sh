@@ -5,8 +5,9 @@
 # (codemark-accuracy-map: the paper's survey grid on renders, closed form,
 # general 6-DoF path and AprilTag 3), writing
 # bench/accuracy_map/results/, copying the heat maps to docs/images/ and
-# writing docs/benchmarks/pose.md (scripts/accuracy-report.py). About 15 minutes on 2 cores; `--quick` runs a small map into
-# a scratch folder instead.
+# writing docs/benchmarks/pose.md (scripts/accuracy-report.py). About 15
+# minutes on 2 cores; `--quick` runs a small map into a scratch folder
+# instead.
 #
 # Usage: scripts/bench-accuracy.sh [--quick] [--build-dir DIR]
 #        [--presets LIST [--renders N] [--renderer own|povray]]
