@@ -101,7 +101,7 @@ struct JobResult
 	std::string dataset, method;
 	bool ok = false;
 	std::string error;	//!< one line when !ok
-	eval::LocalizeSummary summary;  //!< rows, metrics, first fix, per-step time
+	eval::LocalizeSummary summary;	//!< rows, metrics, first fix, per-step time
 	DetectionStats detection;
 	std::optional<Rpe> rpe;
 	std::optional<Alignment> aligned;  //!< ATE after the best SE(2) alignment

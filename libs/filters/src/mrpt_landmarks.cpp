@@ -107,5 +107,4 @@ LandmarkMap loadAnyMap(const std::string& path)
 	return LandmarkMap::load(path);
 }
 
-
 }  // namespace codemark::filters
