@@ -56,7 +56,7 @@ class RunLikelihood
 		LandmarkMap map, std::optional<PoseEstimate> initial)
 		: steps_(std::move(steps)),
 		  po_(std::move(po)),
-		  ekf_(ekf),
+		  ekf_(std::move(ekf)),
 		  map_(std::move(map)),
 		  initial_(std::move(initial))
 	{
@@ -82,6 +82,7 @@ class RunLikelihood
 			innovations.push_back(filter->step(step.odometry.get(), sf).innovations);
 		}
 		std::vector<const std::vector<Innovation>*> steps;
+		steps.reserve(innovations.size());
 		for (const auto& v : innovations) steps.push_back(&v);
 		return summariseInnovations(steps);
 	}
@@ -331,7 +332,7 @@ NoiseFitResult fitSightingNoise(
 	if (!(es.eigenvalues().minCoeff() > 0) || !H.allFinite())
 	{
 		r.relative_std.setConstant(std::numeric_limits<double>::infinity());
-		r.warnings.push_back(
+		r.warnings.emplace_back(
 			"the likelihood is flat along some combination of the scales: the run does not "
 			"identify the model (more sightings at more distances help)");
 	}
@@ -375,7 +376,7 @@ NoiseFitResult fitSightingNoise(
 			"only " + std::to_string(r.sightings) +
 			" sightings: too few to identify four scales (record a longer run)");
 	if (r.width_max_px < 1.5 * r.width_min_px)
-		r.warnings.push_back(
+		r.warnings.emplace_back(
 			"the landmarks were seen at one apparent size only: the constant and "
 			"size-dependent parts cannot be told apart (drive nearer and farther)");
 	return r;
