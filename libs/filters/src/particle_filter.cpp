@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "factories.h"
@@ -207,6 +208,7 @@ StepStats ParticleFilterLocalizer::step(
 	mrpt::obs::CSensoryFrame sf, all;
 	std::vector<const CObservationCodedLandmarks*> coded;
 	const auto motion = actions.getBestMovementEstimation();
+	std::optional<PredictedCloud> cloud;  // computed at the frame's first mapped sighting
 	for (const auto& o : observations)
 	{
 		if (!o) continue;
@@ -225,7 +227,8 @@ StepStats ParticleFilterLocalizer::step(
 				}
 				if (m_converged && motion && motion->poseChange)
 				{
-					Innovation in = predictedInnovation(*c, sg, *motion);
+					if (!cloud) cloud = predictCloud(*motion);
+					Innovation in = predictedInnovation(*cloud, *c, sg);
 					in.id = sg.id;
 					stats.innovations.push_back(in);
 					if (in.gated)
@@ -309,16 +312,9 @@ StepStats ParticleFilterLocalizer::step(
 	return stats;
 }
 
-Innovation ParticleFilterLocalizer::predictedInnovation(
-	const CObservationCodedLandmarks& obs, const CObservationCodedLandmarks::TSighting& sg,
+ParticleFilterLocalizer::PredictedCloud ParticleFilterLocalizer::predictCloud(
 	const mrpt::obs::CActionRobotMovement2D& motion) const
 {
-	// The particles moved by the odometry's mean; its covariance enters
-	// linearised at the weighted mean (no draws: MRPT's generator stays the
-	// update's alone, so seeded runs do not depend on this statistic).
-	const MapLandmark& lm = *m_map->find(sg.id);
-	const mrpt::poses::CPose2D cam = pose::cameraPlanarPose(obs.cameraPose);
-	const mrpt::poses::CPose2D world_T_lm = pose::landmarkPlanarPose(lm.world_T_landmark());
 	mrpt::math::CMatrixDouble33 Cu;
 	mrpt::poses::CPose2D u;
 	motion.poseChange->getCovarianceAndMean(Cu, u);
@@ -326,39 +322,67 @@ Innovation ParticleFilterLocalizer::predictedInnovation(
 	const auto& parts = m_pdf.m_particles;
 	double max_lw = -std::numeric_limits<double>::infinity();
 	for (const auto& p : parts) max_lw = std::max(max_lw, p.log_w);
-	Eigen::Vector3d mean_d = Eigen::Vector3d::Zero();
-	Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+	PredictedCloud c;
+	c.poses.reserve(parts.size());
+	c.weights.reserve(parts.size());
 	double wsum = 0, sc = 0, ss = 0;
-	Eigen::Vector2d mean_xy = Eigen::Vector2d::Zero();
+	Eigen::Vector2d xy = Eigen::Vector2d::Zero();
 	for (const auto& p : parts)
 	{
 		const double w = std::exp(p.log_w - max_lw);
 		const Eigen::Vector3d x = composeMotion(Eigen::Vector3d(p.d.x, p.d.y, p.d.phi), ue);
-		Eigen::Vector3d d = predictLandmarkMeasurement(x, cam, world_T_lm) - sg.L;
-		d[1] = mrpt::math::wrapToPi(d[1]);
-		d[2] = mrpt::math::wrapToPi(d[2]);
-		mean_d += w * d;
-		second += w * d * d.transpose();
-		mean_xy += w * x.head<2>();
+		c.poses.push_back(x);
+		c.weights.push_back(w);
+		xy += w * x.head<2>();
 		sc += w * std::cos(x[2]);
 		ss += w * std::sin(x[2]);
 		wsum += w;
 	}
-	Innovation bad;
-	bad.nis = std::numeric_limits<double>::infinity();
-	bad.gated = true;
-	if (!(wsum > 0)) return bad;
-	mean_d /= wsum;
-	const Eigen::Matrix3d spread = second / wsum - mean_d * mean_d.transpose();
-	// The motion noise at the mean predicted pose: Q = G C_u G^T, through H.
-	const mrpt::math::TPose2D m0 = m_pdf.getMeanVal().asTPose();
-	Eigen::Matrix3d G, H;
-	composeMotion(Eigen::Vector3d(m0.x, m0.y, m0.phi), ue, nullptr, &G);
-	predictLandmarkMeasurement(
-		Eigen::Vector3d(mean_xy[0] / wsum, mean_xy[1] / wsum, std::atan2(ss, sc)), cam, world_T_lm,
-		&H);
-	const Eigen::Matrix3d S =
-		spread + H * G * Cu.asEigen() * G.transpose() * H.transpose() + sg.C_L;
+	if (!(wsum > 0))
+	{
+		// No usable weights: an empty cloud, against which every sighting is gated.
+		c.poses.clear();
+		c.weights.clear();
+		return c;
+	}
+	for (double& w : c.weights) w /= wsum;
+	c.mean = Eigen::Vector3d(xy[0] / wsum, xy[1] / wsum, std::atan2(ss, sc));
+	// G = d(x (+) u)/du depends on the prior yaw only: the mean's, before the
+	// odometry's turn.
+	Eigen::Matrix3d G;
+	composeMotion(Eigen::Vector3d(0, 0, mrpt::math::wrapToPi(c.mean[2] - ue[2])), ue, nullptr, &G);
+	c.motion_cov = G * Cu.asEigen() * G.transpose();
+	return c;
+}
+
+Innovation ParticleFilterLocalizer::predictedInnovation(
+	const PredictedCloud& cloud, const CObservationCodedLandmarks& obs,
+	const CObservationCodedLandmarks::TSighting& sg) const
+{
+	if (cloud.poses.empty())
+	{
+		Innovation bad;
+		bad.nis = std::numeric_limits<double>::infinity();
+		bad.gated = true;
+		return bad;
+	}
+	const MapLandmark& lm = *m_map->find(sg.id);
+	const mrpt::poses::CPose2D cam = pose::cameraPlanarPose(obs.cameraPose);
+	const mrpt::poses::CPose2D world_T_lm = pose::landmarkPlanarPose(lm.world_T_landmark());
+	Eigen::Vector3d mean_d = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+	for (std::size_t i = 0; i < cloud.poses.size(); ++i)
+	{
+		Eigen::Vector3d d = predictLandmarkMeasurement(cloud.poses[i], cam, world_T_lm) - sg.L;
+		d[1] = mrpt::math::wrapToPi(d[1]);
+		d[2] = mrpt::math::wrapToPi(d[2]);
+		mean_d += cloud.weights[i] * d;
+		second += cloud.weights[i] * d * d.transpose();
+	}
+	const Eigen::Matrix3d spread = second - mean_d * mean_d.transpose();
+	Eigen::Matrix3d H;
+	predictLandmarkMeasurement(cloud.mean, cam, world_T_lm, &H);
+	const Eigen::Matrix3d S = spread + H * cloud.motion_cov * H.transpose() + sg.C_L;
 	const Eigen::MatrixXd R = sg.C_L;
 	return makeInnovation(-mean_d, S, m_opts.gate_chi2, &R);
 }

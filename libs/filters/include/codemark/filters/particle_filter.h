@@ -18,7 +18,9 @@
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/slam/CMonteCarloLocalization2D.h>
 
+#include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 namespace codemark::filters
 {
@@ -103,15 +105,30 @@ class ParticleFilterLocalizer : public Localizer
 	 * coded sightings; returns false when it holds no fix. */
 	bool injectAroundFixes(const mrpt::obs::CSensoryFrame& observations);
 
+	/** The particles moved by a step's odometry: the prediction that each
+	 * of the step's sightings is tested against (predictedInnovation()). */
+	struct PredictedCloud
+	{
+		std::vector<Eigen::Vector3d> poses;	 //!< each particle moved by the odometry's mean
+		std::vector<double> weights;  //!< normalised weights
+		Eigen::Vector3d mean = Eigen::Vector3d::Zero();	 //!< weighted mean (circular yaw)
+		/** The odometry's covariance in the world frame at the mean prior pose,
+		 * G C_u G^T (linearised: no draws, so MRPT's generator stays the
+		 * update's alone and seeded runs do not depend on this statistic). */
+		Eigen::Matrix3d motion_cov = Eigen::Matrix3d::Zero();
+	};
+	/** The current particles moved by \a motion. */
+	PredictedCloud predictCloud(const mrpt::obs::CActionRobotMovement2D& motion) const;
+
 	/** The innovation of sighting \a sg (of a mapped landmark, in \a obs)
-	 * against the predicted measurement distribution: the particles moved
-	 * by \a motion's mean, the weighted mean and covariance of the L they
-	 * predict, plus the motion's covariance (linearised) and the sighting's
+	 * against the predicted measurement distribution of \a cloud: the
+	 * weighted mean and covariance of the L its poses predict, plus the
+	 * motion covariance through the measurement Jacobian and the sighting's
 	 * C_L (as measured, without the likelihood's sigma_scale and floors: the
 	 * statistic judges the sightings' covariances). Gated beyond gate_chi2. */
 	Innovation predictedInnovation(
-		const CObservationCodedLandmarks& obs, const CObservationCodedLandmarks::TSighting& sg,
-		const mrpt::obs::CActionRobotMovement2D& motion) const;
+		const PredictedCloud& cloud, const CObservationCodedLandmarks& obs,
+		const CObservationCodedLandmarks::TSighting& sg) const;
 
    private:
 	/** Throws std::runtime_error when a particle's pose or log-weight, or the
