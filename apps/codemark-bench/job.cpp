@@ -155,17 +155,8 @@ JobResult runJob(
 		std::optional<CameraModel> camera;
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
 
-		filters::StepperOptions so;
-		so.loadFromConfigFile(mcfg, "stepper");
-		pipeline::PipelineOptions po;
-		po.detector.loadFromConfigFile(mcfg, "detector");
-		if (!ds.calibration.empty())
-		{
-			po.pose = pipeline::calibratedPoseOptions(ds.calibration);
-			so.remeasure_sightings = true;
-		}
-		po.pose.loadFromConfigFile(mcfg, "pose");
-		if (!mrpt_map) po.map = map;
+		auto [so, po] = filters::readingOptions(
+			mcfg, ds.calibration, mrpt_map ? std::nullopt : std::optional(map));
 		po.camera_override = camera;
 
 		// ekf-slam builds its own map: the dataset's map is its ground truth

@@ -476,17 +476,9 @@ LocalizeSummary runLocalization(
 	std::optional<GroundTruth> gt;
 	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
 
-	StepperOptions so;
-	so.loadFromConfigFile(cfg, "stepper");
-	pipeline::PipelineOptions po;
-	po.detector.loadFromConfigFile(cfg, "detector");
-	if (!req.calibration.empty())
-	{
-		po.pose = pipeline::calibratedPoseOptions(req.calibration);
-		so.remeasure_sightings = true;
-	}
-	po.pose.loadFromConfigFile(cfg, "pose");
-	if (!req.map_file.empty() && !isMrptLandmarksFile(req.map_file)) po.map = map;
+	const bool spec_map = !req.map_file.empty() && !isMrptLandmarksFile(req.map_file);
+	const auto [so, po] =
+		readingOptions(cfg, req.calibration, spec_map ? std::optional(map) : std::nullopt);
 
 	auto filter = makeLocalizer(s.method, cfg, map, initialPose(cfg));
 	RawlogStepper stepper(req.rawlog, so, po);

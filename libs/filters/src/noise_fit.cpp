@@ -234,16 +234,11 @@ NoiseFitResult fitSightingNoise(
 	if (map.landmarks.empty())
 		throw std::invalid_argument(req.map_file + ": the map has no landmarks");
 
-	pipeline::PipelineOptions po;
-	po.detector.loadFromConfigFile(cfg, "detector");
-	po.pose = pipeline::calibratedPoseOptions(
-		req.calibration.empty() ? pipeline::kDefaultCalibration : req.calibration);
-	po.pose.loadFromConfigFile(cfg, "pose");
-	if (!isMrptLandmarksFile(req.map_file)) po.map = map;
+	// Annotated sightings are measured again: the fit changes C_P anyway.
+	auto [so, po] = readingOptions(
+		cfg, req.calibration.empty() ? pipeline::kDefaultCalibration : req.calibration,
+		isMrptLandmarksFile(req.map_file) ? std::nullopt : std::optional(map));
 	if (!req.camera_file.empty()) po.camera_override = CameraModel::load(req.camera_file);
-	StepperOptions so;
-	so.loadFromConfigFile(cfg, "stepper");
-	so.remeasure_sightings = true;
 	EkfOptions eo;
 	eo.loadFromConfigFile(cfg, "ekf");
 

@@ -84,6 +84,23 @@ void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "remeasure_sightings", remeasure_sightings, -1, -1);
 }
 
+ReadingOptions readingOptions(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& calibration,
+	const std::optional<LandmarkMap>& map)
+{
+	ReadingOptions o;
+	o.stepper.loadFromConfigFile(cfg, "stepper");
+	o.pipeline.detector.loadFromConfigFile(cfg, "detector");
+	if (!calibration.empty())
+	{
+		o.pipeline.pose = pipeline::calibratedPoseOptions(calibration);
+		o.stepper.remeasure_sightings = true;
+	}
+	o.pipeline.pose.loadFromConfigFile(cfg, "pose");
+	o.pipeline.map = map;
+	return o;
+}
+
 CPose2D interpolatePose(double t0, const CPose2D& p0, double t1, const CPose2D& p1, double t)
 {
 	if (!(t1 > t0)) return t >= t1 ? p1 : p0;

@@ -25,6 +25,7 @@
 
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace codemark::filters
@@ -60,6 +61,25 @@ struct StepperOptions : public mrpt::config::CLoadableOptions
 	void saveToConfigFile(
 		mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };
+
+/** What a filter config sets up for reading a rawlog. */
+struct ReadingOptions
+{
+	StepperOptions stepper;	 //!< the config's [stepper]
+	pipeline::PipelineOptions pipeline;	 //!< [detector], C_P, the map's sizes
+};
+
+/** The reading options of the filter config \a cfg: [stepper] and
+ * [detector]; C_P from the calibration \a calibration (a file or a shipped
+ * name, pipeline::calibratedPoseOptions()), then the config's [pose] keys;
+ * each ID's printed size from \a map when given (a map in the spec's
+ * format). An empty \a calibration keeps the default one, and annotated
+ * sightings keep their stored covariances; a set one measures them again
+ * (StepperOptions::remeasure_sightings). Throws as the loaders do, naming
+ * the section, key or file. */
+ReadingOptions readingOptions(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& calibration,
+	const std::optional<LandmarkMap>& map = std::nullopt);
 
 /** One processed camera frame. */
 struct RawlogStep
