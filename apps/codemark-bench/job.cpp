@@ -165,7 +165,7 @@ JobResult runJob(
 		auto filter = filters::makeLocalizer(method, mcfg, prior, filters::initialPose(mcfg));
 		filters::RawlogStepper stepper(ds.rawlog, so, po);
 		filters::RawlogStep step;
-		double filter_s = 0, detect_s = 0, first_t = 0;
+		double filter_s = 0, detect_s = 0;
 		auto t_read = Clock::now();
 		while (true)
 		{
@@ -179,30 +179,14 @@ JobResult runJob(
 			}
 			const filters::StepStats st = filter->step(step.odometry.get(), step.observations);
 			filter_s += seconds(t0, Clock::now());
-			eval::PathRow row;
-			row.step = step.index;
-			row.timestamp = step.timestamp;
-			row.estimate = filter->estimate();
-			row.stats = st;
-			row.truth = gt.poseAt(step.index, step.timestamp, 1e-3, step.actions);
-			if (row.truth && !mrpt_map)
+			const auto truth = gt.poseAt(step.index, step.timestamp, 1e-3, step.actions);
+			if (truth && !mrpt_map)
 				for (const auto& o : step.observations)
 					if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
 						tallyDetections(
-							*lm, *row.truth, map, camera, cfg.min_span_px, so.max_view_angle_deg,
+							*lm, *truth, map, camera, cfg.min_span_px, so.max_view_angle_deg,
 							r.detection);
-			if (step.index == 0) first_t = step.timestamp;
-			if (row.estimate.initialized && s.first_fix_step < 0)
-			{
-				s.first_fix_step = step.index;
-				s.first_fix_time_s = step.timestamp - first_t;
-			}
-			s.sightings_used += st.used;
-			s.sightings_rejected += st.rejected;
-			s.sightings_unknown_id += st.unknown_id;
-			s.reinitializations += st.reinitialized ? 1 : 0;
-			s.rows.push_back(std::move(row));
-			++s.steps;
+			eval::appendStep(s, step, st, filter->estimate(), truth);
 			if (progress) progress(stepper.progress());
 			t_read = Clock::now();
 		}

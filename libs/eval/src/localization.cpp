@@ -342,6 +342,32 @@ void writeScene(const LocalizeSummary& s, const LandmarkMap& map, const std::str
 }
 }  // namespace
 
+void appendStep(
+	LocalizeSummary& s, const RawlogStep& step, const StepStats& stats, const PoseEstimate& e,
+	const std::optional<mrpt::poses::CPose2D>& truth)
+{
+	PathRow row;
+	row.step = step.index;
+	row.timestamp = step.timestamp;
+	row.estimate = e;
+	row.stats = stats;
+	row.truth = truth;
+	if (e.initialized && s.first_fix_step < 0)
+	{
+		s.first_fix_step = step.index;
+		// After the first step's time (this step's when it is the first).
+		s.first_fix_time_s =
+			step.timestamp - (s.rows.empty() ? step.timestamp : s.rows.front().timestamp);
+	}
+	s.sightings_used += stats.used;
+	s.sightings_rejected += stats.rejected;
+	s.sightings_unknown_id += stats.unknown_id;
+	s.sightings_too_oblique += step.sightings_too_oblique;
+	s.reinitializations += stats.reinitialized ? 1 : 0;
+	s.rows.push_back(std::move(row));
+	++s.steps;
+}
+
 void summariseInnovations(LocalizeSummary& s)
 {
 	std::vector<const std::vector<Innovation>*> steps;
@@ -484,7 +510,6 @@ LocalizeSummary runLocalization(
 	RawlogStepper stepper(req.rawlog, so, po);
 	RawlogStep step;
 	double filter_s = 0;
-	double first_t = 0;
 	long images = 0;
 	double detect_s = 0;
 	auto t_read = std::chrono::steady_clock::now();
@@ -513,25 +538,9 @@ LocalizeSummary runLocalization(
 		}
 		const auto t1 = std::chrono::steady_clock::now();
 		filter_s += std::chrono::duration<double>(t1 - t0).count();
-		PathRow row;
-		row.step = step.index;
-		row.timestamp = step.timestamp;
-		row.estimate = filter->estimate();
-		row.stats = st;
-		if (gt) row.truth = gt->poseAt(step.index, step.timestamp, 1e-3, step.actions);
-		if (step.index == 0) first_t = step.timestamp;
-		if (row.estimate.initialized && s.first_fix_step < 0)
-		{
-			s.first_fix_step = step.index;
-			s.first_fix_time_s = step.timestamp - first_t;
-		}
-		s.sightings_used += st.used;
-		s.sightings_rejected += st.rejected;
-		s.sightings_unknown_id += st.unknown_id;
-		s.sightings_too_oblique += step.sightings_too_oblique;
-		s.reinitializations += st.reinitialized ? 1 : 0;
-		s.rows.push_back(std::move(row));
-		++s.steps;
+		appendStep(
+			s, step, st, filter->estimate(),
+			gt ? gt->poseAt(step.index, step.timestamp, 1e-3, step.actions) : std::nullopt);
 		if (progress) progress(stepper.progress());
 		if (on_step) on_step(s, map, *filter);
 		t_read = std::chrono::steady_clock::now();

@@ -7,6 +7,7 @@
  * (SLAM), trajectory.png, trajectory.3Dscene, summary.json.
  */
 #include <codemark/filters/localizer.h>
+#include <codemark/filters/stepper.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <Eigen/Core>
@@ -131,6 +132,13 @@ struct LocalizeSummary
 	std::vector<PathRow> rows;
 	std::vector<filters::MappedLandmark> slam_map;	//!< SLAM only
 };
+
+/** Appends the row of \a step to \a s (its estimate \a e, the filter's
+ * \a stats and the matched \a truth) and updates the counters and the
+ * first fix. */
+void appendStep(
+	LocalizeSummary& s, const filters::RawlogStep& step, const filters::StepStats& stats,
+	const filters::PoseEstimate& e, const std::optional<mrpt::poses::CPose2D>& truth);
 
 /** Sets \a s's NIS fields (nis_mean, nis_dof, nis_count, gated_fraction,
  * nis_verdict) from its rows' innovations; infinite NIS (a covariance that
