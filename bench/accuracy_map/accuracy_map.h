@@ -62,8 +62,7 @@ struct SurveyOptions
 	 * never looks exactly at a landmark's centre, and a landmark dead centre
 	 * in the image mirrors its left and right (top and bottom) edges' pixel
 	 * phases, so their sampling biases cancel in the bearing (and phi2) and
-	 * make C_P look 2x pessimistic there. 0, 0: exactly centred, the grid
-	 * before 2026-12-01. */
+	 * make C_P look 2x pessimistic there. 0, 0: exactly centred. */
 	double aim_jitter_rad = 0.15;
 	double height_jitter_m = 0.2;  //!< see aim_jitter_rad [m]
 	uint64_t seed = 1;	//!< first render seed
