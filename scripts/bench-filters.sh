@@ -27,8 +27,9 @@ doc_header()
 	cat >"$DOC" <<HDR
 # Filter benchmarks
 
-Written by \`scripts/bench-filters.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores,
-$(uname -m)); Release build. Each section below is one function of the script.
+Written by \`scripts/bench-filters.sh\` on $(date -u +%Y-%m-%d), commit
+$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown), $(nproc) cores ($(uname -m)), Release build,
+SEEDS=$SEEDS. Each section below is one function of the script.
 
 HDR
 }
@@ -47,36 +48,22 @@ section_sim()
 			--max-frames "$MAX_FRAMES" --share "$ROOT/share/codemark"
 		echo
 		cat <<'NOTES'
-Notes on the simulated section:
+How the section runs:
 - Every filter reads the pipeline's calibrated C_P (no ini override) and
-  drops coded sightings seen beyond 60 deg from the landmark's normal
-  (`[stepper] max_view_angle_deg`: the range is biased short beyond the
-  detector's validated range). The EKF ("ekf") uses the iterated update
-  (`[ekf] iterations = 10`). ekf-slam runs with the true map as its prior.
-- The targets on the default renders (noise 2, blur 0.8 px): EKF
-  ATE <= 3 cm over the seeds, the runs' mean NEES averaged over the seeds
-  inside the 95% band of one run, first fix at the first frame;
-  tests/filters/test_sim.cpp checks the same on the same seeds. The largest
-  errors are the first fix (one landmark 4 m away, frontal, whose phi2 is
-  weakest there: 7-15 cm, inside its covariance) and single turning steps
-  without a usable sighting (MRPT's Gaussian odometry model at 0.0573 m per
-  radian turned). Since the closed form refines L on P
-  (`[pose] refine_on_primary`, docs/benchmarks/pose.md) the EKF's ATE is
-  2.4-2.8 cm (2.9 cm with the paper's formulas alone). Since the detector
-  restores clipped fills, the calibrated C_P is about half what it was
-  (docs/benchmarks/pose.md): the sightings weigh more against odometry and
-  every EKF run's NEES is in band (3.08), the ATE 2.4 -> 2.8 cm, the
-  particle filter's 2.9 -> 3.3 cm with its NEES below the band (2.34).
-  The pose-fix EKF (ekf-pose) is as accurate, NEES in band.
-- What phi2 adds (SLAM table): on the default renders the coded sightings
-  map the landmarks about 40% better than their BearingRange twin (same
-  filter, point landmarks) and than MRPT's kf-slam filter on that twin, and
-  give each landmark's yaw to under a degree; on the noisy renders the
-  calibrated C_L is too optimistic for phi2 and the twin does better.
-- Noisier images (noise 6, blur 1.2 px): the detector's corners are worse
-  than the calibrated sigma says, so the EKFs are overconfident (NEES far
-  above 3) and bad sightings pull the estimate away; raise `[pose] sigma_px`
-  / `sigma_y_px` (or `[ekf] measurement_cov_scale`) for such images.
+  drops coded sightings seen beyond `[stepper] max_view_angle_deg` from the
+  landmark's normal (the range is biased short beyond the detector's
+  validated range). The EKF ("ekf") uses the iterated update
+  (`[ekf] iterations`); ekf-slam runs with the true map as its prior. The
+  EKF configs keep the mirror-image fold (`[pose] fold_ambiguity`) off:
+  the same far landmark, frame after frame, has its mirror image decided by
+  the same detector bias, which the fold would count as independent.
+- The largest errors are the first fix (one landmark far away and frontal,
+  where phi2 is weakest) and turning steps without a usable sighting
+  (MRPT's Gaussian odometry model).
+- At noise 6, blur 1.2 px the detector's corners are worse than the
+  calibrated sigma says, so the EKFs are over-confident; a calibration
+  fitted to such images (`codemark-calibrate-noise`, docs/calibration.md)
+  or `[ekf] measurement_cov_scale` corrects that.
 - "first fix" is the time from the first frame to the first estimate; the
   EKFs fix at the first frame in which a mapped landmark is detected.
 NOTES
