@@ -9,7 +9,8 @@ Each table in README.md sits between two markers:
 
 `table N` is the N-th table of the report (1-based; a table is a run of
 lines that start with '|'), `columns` keeps those columns (1-based), `rows`
-keeps the header and the rows that contain TEXT. A source file is copied
+keeps the header and the rows that contain TEXT (alternatives separated by
+`;;`: the rows that contain any of them, in the report's order). A source file is copied
 the same way, as a fenced block:
 
     <!-- file examples/quickstart.cpp -->
@@ -58,7 +59,8 @@ def extract(report, index, columns, rows, where):
         sys.exit(f"{where}: {report} has {len(found)} tables, not {index}")
     t = found[index - 1]
     if rows:
-        t = t[:2] + [line for line in t[2:] if rows in line]
+        wanted = [r.strip() for r in rows.split(";;")]
+        t = t[:2] + [line for line in t[2:] if any(w in line for w in wanted)]
     if columns:
         keep = [int(c) - 1 for c in columns.split(",")]
         t = ["| " + " | ".join(cells(line)[k] for k in keep if k < len(cells(line))) + " |"
