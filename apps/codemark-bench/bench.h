@@ -1,11 +1,10 @@
 #pragma once
 /** \file bench.h
  * codemark-bench's internals: the benchmark ini, one job (a dataset run
- * through one method), the metrics that libs/filters does not compute
- * itself (RPE, aligned ATE, detection rate against the ground truth), and
- * the report (CSV, Markdown, plots). App-internal: the per-job loop mirrors
- * eval::runLocalization() with per-frame detection bookkeeping added, so
- * that libs/ stays untouched.
+ * through one method, its metrics from libs/eval and the detection rate
+ * against the ground truth), and the report (CSV, Markdown, plots). The
+ * per-job loop is eval::runLocalization()'s with per-frame detection
+ * bookkeeping and timing added.
  */
 #include <codemark/eval/localization.h>
 
@@ -78,23 +77,6 @@ struct DetectionStats
 	double detect_ms_per_image = 0;	 //!< wall time per image: load + decode + detect + measure [ms]
 };
 
-/** Relative pose error over a time interval. */
-struct Rpe
-{
-	int pairs = 0;
-	double trans_rmse_m = 0;  //!< RMS of the translation of (gt_i^-1 gt_j)^-1 (est_i^-1 est_j) [m]
-	double yaw_rmse_deg = 0;  //!< RMS of its rotation [deg]
-};
-
-/** The least-squares rigid 2D alignment of the estimated positions onto the
- * true ones (Umeyama without scale): aligned = R(yaw_rad) * estimate + t. */
-struct Alignment
-{
-	double yaw_rad = 0;
-	double tx = 0, ty = 0;	//!< [m]
-	double ate_m = 0;  //!< RMS position error after the alignment [m]
-};
-
 /** The result of one job. */
 struct JobResult
 {
@@ -103,8 +85,8 @@ struct JobResult
 	std::string error;	//!< one line when !ok
 	eval::LocalizeSummary summary;	//!< rows, metrics, first fix, per-step time
 	DetectionStats detection;
-	std::optional<Rpe> rpe;
-	std::optional<Alignment> aligned;  //!< ATE after the best SE(2) alignment
+	std::optional<eval::RelativePoseError> rpe;
+	std::optional<eval::PathAlignment> aligned;	 //!< ATE after the best SE(2) alignment
 	double wall_s = 0;	//!< the job's wall time: reading, detection, filtering, outputs [s]
 	std::string out_dir;  //!< where the job's spec section 6 files are
 };
@@ -119,13 +101,6 @@ JobResult runJob(
 	const BenchConfig& cfg, const Dataset& ds, const std::string& method,
 	const std::string& out_dir, std::optional<unsigned> seed,
 	const std::function<void(double)>& progress = {});
-
-/** RPE of \a rows over \a interval_s; none when no pair matches. */
-std::optional<Rpe> relativePoseError(const std::vector<eval::PathRow>& rows, double interval_s);
-
-/** The Alignment of \a rows (initialised, with truth); none with fewer than
- * 2 such rows. */
-std::optional<Alignment> alignPath(const std::vector<eval::PathRow>& rows);
 
 /** results.csv's header line (no newline). */
 std::string csvHeader();

@@ -1,5 +1,5 @@
-// codemark-bench: one job = one dataset through one method, and the metrics
-// libs/filters does not compute (RPE, aligned ATE, detection rate).
+// codemark-bench: one job = one dataset through one method, its metrics
+// (libs/eval) and the detection rate against the ground truth.
 #include <codemark/landmark/random.h>
 #include <codemark/eval/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
@@ -70,67 +70,6 @@ void tallyDetections(
 }
 }  // namespace
 
-std::optional<Rpe> relativePoseError(const std::vector<eval::PathRow>& rows, double interval_s)
-{
-	std::vector<const eval::PathRow*> ok;
-	for (const auto& r : rows)
-		if (r.estimate.initialized && r.truth) ok.push_back(&r);
-	Rpe rpe;
-	double st = 0, sy = 0;
-	std::size_t j = 0;
-	for (std::size_t i = 0; i < ok.size(); ++i)
-	{
-		j = std::max(j, i + 1);
-		while (j < ok.size() && ok[j]->timestamp - ok[i]->timestamp < interval_s) ++j;
-		if (j >= ok.size()) break;
-		const CPose2D rel_gt = *ok[j]->truth - *ok[i]->truth;
-		const CPose2D rel_est = ok[j]->estimate.mean - ok[i]->estimate.mean;
-		const CPose2D e = rel_est - rel_gt;	 // rel_gt^-1 (+) rel_est
-		st += e.x() * e.x() + e.y() * e.y();
-		sy += mrpt::math::wrapToPi(e.phi()) * mrpt::math::wrapToPi(e.phi());
-		++rpe.pairs;
-	}
-	if (rpe.pairs == 0) return std::nullopt;
-	rpe.trans_rmse_m = std::sqrt(st / rpe.pairs);
-	rpe.yaw_rmse_deg = std::sqrt(sy / rpe.pairs) * 180.0 / M_PI;
-	return rpe;
-}
-
-std::optional<Alignment> alignPath(const std::vector<eval::PathRow>& rows)
-{
-	std::vector<Eigen::Vector2d> e, g;
-	for (const auto& r : rows)
-		if (r.estimate.initialized && r.truth)
-		{
-			e.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
-			g.emplace_back(r.truth->x(), r.truth->y());
-		}
-	if (e.size() < 2) return std::nullopt;
-	// Least-squares rotation and translation (Umeyama without scale): from
-	// the centred cross-covariance, the rotation angle is atan2 of its
-	// antisymmetric over its symmetric part.
-	Eigen::Vector2d me = Eigen::Vector2d::Zero(), mg = Eigen::Vector2d::Zero();
-	for (std::size_t i = 0; i < e.size(); ++i) me += e[i], mg += g[i];
-	me /= e.size(), mg /= g.size();
-	double sxx = 0, sxy = 0;
-	for (std::size_t i = 0; i < e.size(); ++i)
-	{
-		const Eigen::Vector2d a = e[i] - me, b = g[i] - mg;
-		sxx += a.dot(b);
-		sxy += a.x() * b.y() - a.y() * b.x();
-	}
-	const double th = std::atan2(sxy, sxx);
-	const Eigen::Rotation2Dd R(th);
-	Alignment a;
-	a.yaw_rad = th;
-	const Eigen::Vector2d t = mg - R * me;
-	a.tx = t.x(), a.ty = t.y();
-	double s = 0;
-	for (std::size_t i = 0; i < e.size(); ++i) s += (R * e[i] + t - g[i]).squaredNorm();
-	a.ate_m = std::sqrt(s / e.size());
-	return a;
-}
-
 JobResult runJob(
 	const BenchConfig& cfg, const Dataset& ds, const std::string& method,
 	const std::string& out_dir, std::optional<unsigned> seed,
@@ -199,8 +138,8 @@ JobResult runJob(
 		// true first pose), as codemark-localize reports them.
 		s.metrics = eval::computeMetrics(s.rows, prior.landmarks.empty());
 		eval::summariseInnovations(s);
-		r.rpe = relativePoseError(s.rows, cfg.rpe_interval_s);
-		r.aligned = alignPath(s.rows);
+		r.rpe = eval::relativePoseError(s.rows, cfg.rpe_interval_s);
+		r.aligned = eval::alignPath(s.rows);
 		eval::writeOutputs(s, map, out_dir);
 		r.ok = true;
 	}

@@ -320,9 +320,10 @@ std::vector<std::string> writeDatasetPlots(
 	{
 		// ekf-slam's path lives in the frame of its first fix: drawn aligned.
 		const bool align = ok[k]->method == "ekf-slam" && ok[k]->aligned;
-		const Eigen::Rotation2Dd R(align ? ok[k]->aligned->yaw_rad : 0.0);
-		const Eigen::Vector2d t = align ? Eigen::Vector2d(ok[k]->aligned->tx, ok[k]->aligned->ty)
-										: Eigen::Vector2d::Zero();
+		const mrpt::poses::CPose2D A =
+			align ? ok[k]->aligned->truth_T_estimate : mrpt::poses::CPose2D();
+		const Eigen::Rotation2Dd R(A.phi());
+		const Eigen::Vector2d t = align ? Eigen::Vector2d(A.x(), A.y()) : Eigen::Vector2d::Zero();
 		std::vector<cv::Point> est;
 		for (const auto& row : ok[k]->summary.rows)
 			if (row.estimate.initialized)

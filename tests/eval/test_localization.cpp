@@ -255,3 +255,60 @@ TEST(Metrics, AlignSE2RecoversARigidTransform)
 	EXPECT_NE(summaryJson(ls).find("\"alignment\": \"se2_least_squares\""), std::string::npos);
 	EXPECT_NE(summaryJson(ls).find("\"ate_rmse_anchored_m\""), std::string::npos);
 }
+
+// alignPath(): the same rigid copy, through the rows' positions only.
+TEST(Metrics, AlignPathRecoversARigidTransformAndNeedsTwoRows)
+{
+	const CPose2D truth_T_est(-0.4, 2.1, -1.2);
+	std::vector<PathRow> rows(12);
+	for (std::size_t i = 0; i < rows.size(); ++i)
+	{
+		const double a = 0.5 * static_cast<double>(i);
+		const CPose2D truth(a, std::sin(a), 0.2 * a);
+		rows[i].truth = truth;
+		rows[i].estimate.initialized = true;
+		rows[i].estimate.mean = CPose2D() - truth_T_est + truth;
+	}
+	const auto al = alignPath(rows);
+	ASSERT_TRUE(al);
+	EXPECT_LT(al->ate_m, 1e-9);
+	EXPECT_NEAR(al->truth_T_estimate.x(), truth_T_est.x(), 1e-9);
+	EXPECT_NEAR(al->truth_T_estimate.y(), truth_T_est.y(), 1e-9);
+	EXPECT_NEAR(al->truth_T_estimate.phi(), truth_T_est.phi(), 1e-9);
+	// A position error that no rigid motion explains stays.
+	rows[3].estimate.mean = rows[3].estimate.mean + CPose2D(0.3, 0, 0);
+	EXPECT_GT(alignPath(rows)->ate_m, 0.05);
+	// Rows without truth or uninitialised do not count.
+	std::vector<PathRow> few(rows.begin(), rows.begin() + 3);
+	few[1].truth.reset();
+	few[2].estimate.initialized = false;
+	EXPECT_FALSE(alignPath(few));
+}
+
+// RPE: invariant to a rigid transform of the whole path; a path that moves
+// 10% too far reads 10% of the motion over the interval.
+TEST(Metrics, RelativePoseErrorOfKnownPaths)
+{
+	const CPose2D offset(3, -1, 0.7);
+	std::vector<PathRow> rows(40);
+	for (std::size_t i = 0; i < rows.size(); ++i)
+	{
+		const double k = static_cast<double>(i);
+		rows[i].timestamp = 0.1 * k;
+		rows[i].truth = CPose2D(0.1 * k, 0, 0);
+		rows[i].estimate.initialized = true;
+		rows[i].estimate.mean = offset + *rows[i].truth;
+	}
+	const auto rigid = relativePoseError(rows, 1.0);
+	ASSERT_TRUE(rigid);
+	EXPECT_GE(rigid->pairs, 29);  // j - i is 10 or 11 (0.1 s steps in floating point)
+	EXPECT_LE(rigid->pairs, 30);
+	EXPECT_LT(rigid->trans_rmse_m, 1e-9);
+	EXPECT_LT(rigid->yaw_rmse_deg, 1e-7);
+	for (auto& r : rows) r.estimate.mean = CPose2D(1.1 * r.truth->x(), 0, 0);
+	const auto scaled = relativePoseError(rows, 1.0);
+	ASSERT_TRUE(scaled);
+	EXPECT_GE(scaled->trans_rmse_m, 0.1 - 1e-9);
+	EXPECT_LE(scaled->trans_rmse_m, 0.11 + 1e-9);
+	EXPECT_FALSE(relativePoseError(rows, 10.0));
+}

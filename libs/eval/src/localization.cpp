@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -58,6 +59,53 @@ mrpt::poses::CPose2D alignSE2(
 	const Eigen::Rotation2Dd R(th);
 	const Eigen::Vector2d t = mb - R * ma;
 	return mrpt::poses::CPose2D(t.x(), t.y(), th);
+}
+
+std::optional<RelativePoseError> relativePoseError(
+	const std::vector<PathRow>& rows, double interval_s)
+{
+	std::vector<const PathRow*> ok;
+	for (const auto& r : rows)
+		if (r.estimate.initialized && r.truth) ok.push_back(&r);
+	RelativePoseError rpe;
+	double st = 0, sy = 0;
+	std::size_t j = 0;
+	for (std::size_t i = 0; i < ok.size(); ++i)
+	{
+		j = std::max(j, i + 1);
+		while (j < ok.size() && ok[j]->timestamp - ok[i]->timestamp < interval_s) ++j;
+		if (j >= ok.size()) break;
+		const CPose2D rel_gt = *ok[j]->truth - *ok[i]->truth;
+		const CPose2D rel_est = ok[j]->estimate.mean - ok[i]->estimate.mean;
+		const CPose2D e = rel_est - rel_gt;	 // rel_gt^-1 (+) rel_est
+		st += e.x() * e.x() + e.y() * e.y();
+		sy += mrpt::math::wrapToPi(e.phi()) * mrpt::math::wrapToPi(e.phi());
+		++rpe.pairs;
+	}
+	if (rpe.pairs == 0) return std::nullopt;
+	rpe.trans_rmse_m = std::sqrt(st / rpe.pairs);
+	rpe.yaw_rmse_deg = std::sqrt(sy / rpe.pairs) * 180.0 / M_PI;
+	return rpe;
+}
+
+std::optional<PathAlignment> alignPath(const std::vector<PathRow>& rows)
+{
+	std::vector<Eigen::Vector2d> e, g;
+	for (const auto& r : rows)
+		if (r.estimate.initialized && r.truth)
+		{
+			e.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
+			g.emplace_back(r.truth->x(), r.truth->y());
+		}
+	if (e.size() < 2) return std::nullopt;
+	PathAlignment a;
+	a.truth_T_estimate = alignSE2(e, g);
+	const Eigen::Rotation2Dd R(a.truth_T_estimate.phi());
+	const Eigen::Vector2d t(a.truth_T_estimate.x(), a.truth_T_estimate.y());
+	double s = 0;
+	for (std::size_t i = 0; i < e.size(); ++i) s += (R * e[i] + t - g[i]).squaredNorm();
+	a.ate_m = std::sqrt(s / static_cast<double>(e.size()));
+	return a;
 }
 
 std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool align_se2)

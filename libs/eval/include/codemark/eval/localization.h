@@ -165,6 +165,30 @@ void addLandmarkErrors(
 mrpt::poses::CPose2D alignSE2(
 	const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b);
 
+/** Relative pose error over a time interval. */
+struct RelativePoseError
+{
+	int pairs = 0;	//!< pairs (i, j) compared: j the first step at least the interval after i
+	double trans_rmse_m = 0;  //!< RMS of the translation of (gt_i^-1 gt_j)^-1 (est_i^-1 est_j) [m]
+	double yaw_rmse_deg = 0;  //!< RMS of its rotation [deg]
+};
+
+/** The RPE of \a rows (the initialised ones with truth) over \a interval_s
+ * [s]; none when no pair is that far apart. */
+std::optional<RelativePoseError> relativePoseError(
+	const std::vector<PathRow>& rows, double interval_s);
+
+/** A path's least-squares rigid alignment onto its ground truth. */
+struct PathAlignment
+{
+	mrpt::poses::CPose2D truth_T_estimate;	//!< aligned = truth_T_estimate (+) estimate
+	double ate_m = 0;  //!< RMS position error after the alignment [m]
+};
+
+/** The alignSE2() of \a rows' estimated positions (initialised, with truth)
+ * onto the true ones; none with fewer than 2 such rows. */
+std::optional<PathAlignment> alignPath(const std::vector<PathRow>& rows);
+
 /** Runs the whole thing and writes the outputs. \a progress(fraction) is
  * called after each step. Throws std::runtime_error / std::invalid_argument
  * with one line naming the file, line or entry on bad input. */
