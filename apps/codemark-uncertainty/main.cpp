@@ -132,7 +132,7 @@ int main(int argc, char** argv)
 			const cp::SizeAdvice a = cp::sizeFor(
 				camera, noise, acc_m, acc_deg * M_PI / 180, distance_arg.getValue(),
 				angle_arg.getValue() * M_PI / 180, k_arg.getValue(), min_size_arg.getValue());
-			std::cout << cp::describeSizeAdvice(a, k_arg.getValue());
+			std::cout << codemark::eval::describeSizeAdvice(a, k_arg.getValue());
 			did = true;
 			if (!a.found) return 2;
 		}
@@ -143,10 +143,10 @@ int main(int argc, char** argv)
 			for (double x = 0.5; x <= dmax + 1e-9; x += 0.5) d.push_back(x);
 			std::cout
 				<< (calibration_arg.isSet()
-						? cp::accuracyTable(
+						? codemark::eval::accuracyTable(
 							  camera, scale_arg.getValue(), noise, noise_label,
 							  angle_arg.getValue() * M_PI / 180, d, min_size_arg.getValue())
-						: cp::accuracyTable(
+						: codemark::eval::accuracyTable(
 							  camera, scale_arg.getValue(), sigma,
 							  angle_arg.getValue() * M_PI / 180, d, min_size_arg.getValue()));
 			did = true;

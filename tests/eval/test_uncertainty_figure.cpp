@@ -33,3 +33,22 @@ TEST(UncertaintyFigure, WrittenWithEllipses)
 	std::remove(path.c_str());
 	EXPECT_THROW(drawUncertaintyFigure("/nonexistent-dir/x.png", cam, fo), std::exception);
 }
+
+// The text reports: the table marks what the detector can use, the size
+// advice names the scale and the printed sizes it found.
+TEST(UncertaintyReports, TableAndSizeAdvice)
+{
+	const CameraModel cam;
+	const std::string t = accuracyTable(cam, 1.0, 0.05, 0.0, {0.5, 1.0, 4.5});
+	EXPECT_NE(t.find("yes"), std::string::npos);
+	EXPECT_NE(t.find("too small"), std::string::npos);	// 4.5 m: 28 px
+	const pose::SizeAdvice a = pose::sizeFor(cam, 0.05, 0.02, M_PI / 180, 2.0, 0.0, 2.0, 30);
+	ASSERT_TRUE(a.found);
+	const std::string d = describeSizeAdvice(a, 2.0);
+	EXPECT_NE(d.find("reference square"), std::string::npos);
+	EXPECT_NE(d.find("2.0 sigma"), std::string::npos);
+	EXPECT_NE(
+		describeSizeAdvice(pose::sizeFor(cam, 1.0, 0.001, 0.001, 4.0, 0.0), 2.0)
+			.find("no landmark size"),
+		std::string::npos);
+}

@@ -59,19 +59,10 @@ TEST(Uncertainty, SizeForMeetsTheRequestMinimally)
 				k * u.sigma_position_m > acc_m || k * u.sigma_heading_rad > acc_rad ||
 				u.size_px < 30)
 				<< "d " << d << " a " << a;
-			EXPECT_FALSE(describeSizeAdvice(s, k).empty());
 		}
 	// Impossible: 1 mm at 4 m with 1 px noise.
 	const SizeAdvice no = sizeFor(cam, 1.0, 0.001, 0.001, 4.0, 0.0);
 	EXPECT_FALSE(no.found);
 	EXPECT_NE(no.reason.find("largest"), std::string::npos);
 	EXPECT_THROW(sizeFor(cam, 0.05, -1, 0.1, 2, 0), std::invalid_argument);
-}
-
-TEST(Uncertainty, Table)
-{
-	const CameraModel cam;
-	const std::string t = accuracyTable(cam, 1.0, 0.05, 0.0, {0.5, 1.0, 4.5});
-	EXPECT_NE(t.find("yes"), std::string::npos);
-	EXPECT_NE(t.find("too small"), std::string::npos);	// 4.5 m: 28 px
 }

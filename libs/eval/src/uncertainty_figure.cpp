@@ -193,4 +193,66 @@ FigureScales drawUncertaintyFigure(
 	return {mag, hmag};
 }
 
+std::string describeSizeAdvice(const pose::SizeAdvice& a, double k)
+{
+	std::ostringstream s;
+	if (!a.found)
+	{
+		s << "no landmark size meets the request: " << a.reason << "\n";
+		return s.str();
+	}
+	const LandmarkGeometry g = LandmarkGeometry::scaled(a.scale);
+	s << "scale " << fmt(a.scale, 3) << " (" << a.reason << "): outer frame "
+	  << fmt(g.outer_size_m * 1000, 1) << " mm, reference square " << fmt(g.inner_size_m * 1000, 1)
+	  << " mm, code cells " << fmt(g.cell_size_m * 1000, 1) << " mm\n";
+	s << "predicted there: reference square " << fmt(a.at.size_px, 1) << " px tall; " << fmt(k, 1)
+	  << " sigma: position " << fmt(k * a.at.sigma_position_m * 1000, 2)
+	  << " mm (worst direction), heading " << fmt(k * a.at.sigma_heading_rad * 180 / M_PI, 3)
+	  << " deg, range " << fmt(k * a.at.sigma_l2_m * 1000, 2) << " mm\n";
+	return s.str();
+}
+
+std::string accuracyTable(
+	const CameraModel& camera, double scale, double sigma_px, double angle,
+	const std::vector<double>& distances, double min_size_px)
+{
+	return accuracyTable(
+		camera, scale, pose::constantNoise(sigma_px), "sigma_px " + fmt(sigma_px, 3), angle,
+		distances, min_size_px);
+}
+
+std::string accuracyTable(
+	const CameraModel& camera, double scale, const pose::PoseOptions& noise,
+	const std::string& noise_label, double angle, const std::vector<double>& distances,
+	double min_size_px)
+{
+	const LandmarkGeometry g = LandmarkGeometry::scaled(scale);
+	std::ostringstream s;
+	s << "# landmark scale " << fmt(scale, 3) << " (reference square "
+	  << fmt(g.inner_size_m * 1000, 1) << " mm), view angle " << fmt(angle * 180 / M_PI, 1)
+	  << " deg, " << noise_label << ", camera " << camera.width() << "x" << camera.height()
+	  << " fx " << fmt(camera.fx(), 1) << "; 1-sigma values\n";
+	s << "# dist_m  size_px  l2_mm  phi1_deg  phi2_deg  pos_mm  heading_deg  usable\n";
+	for (const double d : distances)
+	{
+		const pose::SightingUncertainty u = pose::predictUncertainty(camera, g, noise, d, angle);
+		s << std::setw(8) << fmt(d, 2);
+		if (u.measurement.L[0] <= 0)
+		{
+			s << "  (not in front of the camera)\n";
+			continue;
+		}
+		s << std::setw(9) << fmt(u.size_px, 1) << std::setw(7) << fmt(u.sigma_l2_m * 1000, 2)
+		  << std::setw(10) << fmt(u.sigma_phi1_rad * 180 / M_PI, 4) << std::setw(10)
+		  << fmt(u.sigma_phi2_rad * 180 / M_PI, 3) << std::setw(8)
+		  << fmt(u.sigma_position_m * 1000, 1) << std::setw(13)
+		  << fmt(u.sigma_heading_rad * 180 / M_PI, 3) << "  "
+		  << (!u.in_image				? "no (not in image)"
+			  : u.size_px < min_size_px ? "no (too small)"
+										: "yes")
+		  << "\n";
+	}
+	return s.str();
+}
+
 }  // namespace codemark::eval

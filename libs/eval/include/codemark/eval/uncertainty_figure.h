@@ -2,7 +2,7 @@
 /** \file uncertainty_figure.h
  * The paper's Fig. 3 as a PNG: the predicted uncertainty of a sighting
  * (pose::predictUncertainty()) on a grid of robot positions in front of a
- * landmark, drawn for codemark-uncertainty.
+ * landmark, drawn for codemark-uncertainty; and that tool's text reports.
  */
 #include <codemark/landmark/camera.h>
 #include <codemark/pose/uncertainty.h>
@@ -52,5 +52,25 @@ struct FigureOptions
  * Throws std::runtime_error when the file cannot be written. */
 FigureScales drawUncertaintyFigure(
 	const std::string& path, const CameraModel& camera, const FigureOptions& options);
+
+/** A text report of \a advice: the scale, the printed sizes and the
+ * predicted accuracy at that scale. */
+std::string describeSizeAdvice(const pose::SizeAdvice& advice, double k_sigma);
+
+/** The accuracy to expect from a landmark of \a scale across \a distances_m
+ * at \a view_angle_rad (level camera, landmark centred), as a text table:
+ * distance, size in px, sigma of l2, phi1, phi2, of the position (worst
+ * direction) and heading, and whether the detector can use it (size >=
+ * \a min_size_px and in the image). */
+std::string accuracyTable(
+	const CameraModel& camera, double scale, double sigma_px, double view_angle_rad,
+	const std::vector<double>& distances_m, double min_size_px = 30.0);
+
+/** accuracyTable() with C_P from \a noise's noise model, described in the
+ * header line as \a noise_label. */
+std::string accuracyTable(
+	const CameraModel& camera, double scale, const pose::PoseOptions& noise,
+	const std::string& noise_label, double view_angle_rad, const std::vector<double>& distances_m,
+	double min_size_px = 30.0);
 
 }  // namespace codemark::eval

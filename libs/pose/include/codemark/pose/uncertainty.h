@@ -78,24 +78,4 @@ SizeAdvice sizeFor(
 	const CameraModel& camera, const PoseOptions& noise, double position_m, double heading_rad,
 	double distance_m, double view_angle_rad, double k_sigma = 2.0, double min_size_px = 30.0);
 
-/** A text report of \a advice: the scale, the printed sizes and the
- * predicted accuracy at that scale. */
-std::string describeSizeAdvice(const SizeAdvice& advice, double k_sigma);
-
-/** The accuracy to expect from a landmark of \a scale across \a distances_m
- * at \a view_angle_rad (level camera, landmark centred), as a text table:
- * distance, size in px, sigma of l2, phi1, phi2, of the position (worst
- * direction) and heading, and whether the detector can use it (size >=
- * \a min_size_px and in the image). */
-std::string accuracyTable(
-	const CameraModel& camera, double scale, double sigma_px, double view_angle_rad,
-	const std::vector<double>& distances_m, double min_size_px = 30.0);
-
-/** accuracyTable() with C_P from \a noise's noise model, described in the
- * header line as \a noise_label. */
-std::string accuracyTable(
-	const CameraModel& camera, double scale, const PoseOptions& noise,
-	const std::string& noise_label, double view_angle_rad, const std::vector<double>& distances_m,
-	double min_size_px = 30.0);
-
 }  // namespace codemark::pose
