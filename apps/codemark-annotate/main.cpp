@@ -57,6 +57,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> threads(
 			"", "threads", "worker threads (0: all cores)", false, 0, "N", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		codemark::pipeline::AnnotateOptions o;
@@ -129,6 +130,10 @@ int main(int argc, char** argv)
 		for (const auto& [id, n] : s.per_id) std::cout << " " << id << ":" << n;
 		std::cout << "\nwrote " << out.getValue() << "\n";
 		return 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

@@ -42,13 +42,18 @@ int main(int argc, char** argv)
 			"held fixed). Reads rawlogs of either MRPT format, with images (detected with the "
 			"starting calibration) or annotated landmark observations (measured again from "
 			"their corners). Errors of the map's survey are absorbed into the noise it finds. "
-			"Writes a calibration file (docs/calibration.md) for --calibration of every tool.",
+			"Writes a calibration file (docs/calibration.md) for --calibration of every tool. "
+			"With --scale K instead of a run, writes the starting calibration with every sigma "
+			"multiplied by K (C_P by K^2), e.g. after codemark-localize reads covariances too "
+			"small by about K^2x.",
 			' ', "0.1");
 		TCLAP::ValueArg<std::string> rawlog(
-			"r", "rawlog", "the recorded run, with odometry", true, "", "IN.rawlog", cmd);
+			"r", "rawlog", "the recorded run, with odometry (required unless --scale)", false, "",
+			"IN.rawlog", cmd);
 		TCLAP::ValueArg<std::string> map(
-			"m", "map", "landmark map (spec) or MRPT landmark ground truth", true, "", "MAP.txt",
-			cmd);
+			"m", "map",
+			"landmark map (spec) or MRPT landmark ground truth (required unless --scale)", false,
+			"", "MAP.txt", cmd);
 		TCLAP::ValueArg<std::string> camera(
 			"", "camera", "camera file replacing the camera stored in the rawlog", false, "",
 			"CAMERA.ini", cmd);
@@ -67,8 +72,41 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> evals(
 			"", "max-evaluations", "likelihood evaluations of the search (default 400)", false, 400,
 			"N", cmd);
+		TCLAP::ValueArg<double> scale(
+			"", "scale",
+			"no fit: write the starting calibration with every sigma multiplied by K (> 0)", false,
+			1.0, "K", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
+
+		std::string command = "codemark-calibrate-noise";
+		for (int a = 1; a < argc; ++a) command += std::string(" ") + argv[a];
+		if (scale.isSet())
+		{
+			if (!(scale.getValue() > 0) || !std::isfinite(scale.getValue()))
+				throw TCLAP::ArgException("must be finite and > 0", "scale");
+			if (rawlog.isSet() || map.isSet())
+				throw TCLAP::ArgException(
+					"--scale writes a calibration without a run: "
+					"drop --rawlog and --map, or --scale",
+					"scale");
+			const std::string from = codemark::pose::resolveCalibration(start.getValue());
+			codemark::pose::saveCalibration(
+				out.getValue(),
+				codemark::pose::scaledNoiseModel(
+					codemark::pose::loadCalibration(from), scale.getValue()),
+				{"codemark calibration: " + from + " with every sigma multiplied by " +
+					 std::to_string(scale.getValue()),
+				 "made by: " + command,
+				 "date: " + mrpt::system::dateTimeToString(mrpt::Clock::now())});
+			std::printf("wrote %s\n", out.getValue().c_str());
+			return 0;
+		}
+		if (!rawlog.isSet() || !map.isSet())
+			throw TCLAP::ArgException(
+				"required to fit (or --scale to scale a calibration)",
+				rawlog.isSet() ? "map" : "rawlog");
 
 		codemark::filters::NoiseFitRequest req;
 		req.rawlog = rawlog.getValue();
@@ -112,8 +150,6 @@ int main(int argc, char** argv)
 		for (const auto& w : r.warnings)
 			std::fprintf(stderr, "codemark-calibrate-noise: warning: %s\n", w.c_str());
 
-		std::string command = "codemark-calibrate-noise";
-		for (int a = 1; a < argc; ++a) command += std::string(" ") + argv[a];
 		char data[512];
 		std::snprintf(
 			data, sizeof data,
@@ -130,6 +166,10 @@ int main(int argc, char** argv)
 			 "date: " + mrpt::system::dateTimeToString(mrpt::Clock::now())});
 		std::printf("wrote %s\n", out.getValue().c_str());
 		return 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

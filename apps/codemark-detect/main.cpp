@@ -359,6 +359,7 @@ int main(int argc, char** argv)
 		// Our own one-line error per unreadable input replaces OpenCV's
 		// decoder warnings on stderr.
 		cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		// Single-threaded: time_ms is the detector's own, comparable figure.
@@ -406,6 +407,10 @@ int main(int argc, char** argv)
 		}
 		for (const auto& in : inputs_arg.getValue()) r.input(in);
 		return r.failures ? 1 : 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

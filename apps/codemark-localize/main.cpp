@@ -83,6 +83,7 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg gui_wait(
 			"", "gui-wait", "--gui: at the end, wait for a key in the window", cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		codemark::eval::LocalizeRequest req;
@@ -173,6 +174,10 @@ int main(int argc, char** argv)
 						 "calibration.ini";
 		std::cout << "\n";
 		return 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

@@ -110,6 +110,7 @@ int main(int argc, char** argv)
 			"with --renderer povray: also write linear_000.png, ... (POV-Ray's 16-bit linear "
 			"renders, before the camera pipeline) and povray.ini (the POV-Ray options used)",
 			cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		const LandmarkMap map = LandmarkMap::load(mapArg.getValue());
@@ -214,6 +215,10 @@ int main(int argc, char** argv)
 				  << " landmark sightings in view; wrote " << out.string()
 				  << "/{frame_*.png,truth.jsonl,camera.ini,render.ini}\n";
 		return 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

@@ -47,6 +47,7 @@ int main(int argc, char** argv)
 			"", "preset", codemark::app::presetHelp() + " in [render]", false, "", "NAME", cmd);
 		codemark::app::PovrayArgs pov(cmd);
 		TCLAP::SwitchArg quiet("q", "quiet", "no progress bar", cmd);
+		cmd.setExceptionHandling(false);  // one-line errors, below
 		cmd.parse(argc, argv);
 
 		codemark::sim::DatasetOptions opts;
@@ -78,6 +79,10 @@ int main(int argc, char** argv)
 				  << sum.sightings << " landmark sightings in view; wrote " << out.getValue()
 				  << "/dataset.rawlog\n";
 		return 0;
+	}
+	catch (const TCLAP::ExitException& e)  // --help, --version
+	{
+		return e.getExitStatus();
 	}
 	catch (const TCLAP::ArgException& e)
 	{

@@ -258,6 +258,31 @@ case("codemark-accuracy-map", "calibration_badcorr",
      ["--out", "{o}", "--no-apriltag", "--calibration", "{d}/cal_badcorr.ini"], r"cal_badcorr.ini:\d+: corr_y12")
 case("codemark-localize", "gt_badnum", loc("{d}/good.rawlog", extra=["-g", "{d}/gt_badnum.txt"]), "gt_badnum.txt:1")
 
+# codemark-calibrate-noise: the run, the map, the starting calibration and
+# the config; --scale without a run.
+CAL_NOISE = ["-q", "-o", "{o}/fit.ini"]
+for f in ["does_not_exist.rawlog", "empty.rawlog", "text.rawlog", "truncated.rawlog", "bitflip.rawlog",
+          "scans.rawlog", "foreign.rawlog", "nan_odo.rawlog"]:
+    case("codemark-calibrate-noise", "rawlog_" + f.split(".")[0], CAL_NOISE + ["-r", "{d}/" + f, "-m", "{d}/map.txt"],
+         re.escape(f))
+for f, where in [("does_not_exist.txt", "does_not_exist.txt"), ("map_nolm.txt", "map_nolm.txt"),
+                 ("map_badnum.txt", "map_badnum.txt:3")]:
+    case("codemark-calibrate-noise", "map_" + f.split(".")[0].replace("map_", ""),
+         CAL_NOISE + ["-r", "{d}/good.rawlog", "-m", "{d}/" + f], where)
+case("codemark-calibrate-noise", "calibration_badcorr",
+     CAL_NOISE + ["-r", "{d}/good.rawlog", "-m", "{d}/map.txt", "--calibration", "{d}/cal_badcorr.ini"],
+     r"cal_badcorr.ini:\d+: corr_y12")
+case("codemark-calibrate-noise", "config_missing",
+     CAL_NOISE + ["-r", "{d}/good.rawlog", "-m", "{d}/map.txt", "-c", "{d}/does_not_exist.ini"], "does_not_exist.ini")
+case("codemark-calibrate-noise", "no_rawlog", CAL_NOISE + ["-m", "{d}/map.txt"], "rawlog")
+case("codemark-calibrate-noise", "scale_zero", CAL_NOISE + ["--scale", "0"], "scale")
+case("codemark-calibrate-noise", "scale_nan", CAL_NOISE + ["--scale", "nan"], "scale")
+case("codemark-calibrate-noise", "scale_with_run", CAL_NOISE + ["--scale", "2", "-r", "{d}/good.rawlog"], "scale")
+case("codemark-calibrate-noise", "scale_badcorr", CAL_NOISE + ["--scale", "2", "--calibration", "{d}/cal_badcorr.ini"],
+     r"cal_badcorr.ini:\d+: corr_y12")
+case("codemark-calibrate-noise", "scale_family", CAL_NOISE + ["--scale", "2", "--calibration", "family"], "",
+     expect="clean")
+
 # codemark-bench (if built): a missing and an empty datasets ini.
 case("codemark-bench", "config_missing", ["{d}/does_not_exist.ini"], "does_not_exist.ini")
 case("codemark-bench", "config_empty", ["{d}/empty.ini"], "empty.ini")
