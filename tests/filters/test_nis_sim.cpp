@@ -170,6 +170,8 @@ TEST(CalibrateNoise, FitFromWrongModelsRestoresTheFilter)
 				<< "seed " << seed << " from x" << factor;
 			EXPECT_LT(r.after.neg_log_likelihood, r.before.neg_log_likelihood);
 			EXPECT_GE(r.after.sighting_share, 0.25) << "the run identifies the sightings' noise";
+			EXPECT_TRUE(r.relative_std.allFinite() && (r.relative_std.array() > 0).all())
+				<< "every scale has an uncertainty: " << r.relative_std.transpose();
 			// NEES against the truth near its band: the innovations miss the
 			// part of the sightings' error that persists from frame to frame
 			// (docs/design.md), so the band is widened by 1.5 on both sides

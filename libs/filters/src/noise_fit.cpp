@@ -303,28 +303,43 @@ NoiseFitResult fitSightingNoise(
 	r.after = run.evaluate(r.fitted);
 
 	// The curvature of the negative log-likelihood at the optimum (central
-	// differences in the log-scales) gives each scale's uncertainty.
-	const double h = 0.05, f0 = r.after.neg_log_likelihood + prior(best);
-	Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
-	for (int i = 0; i < 4; ++i)
-		for (int j = i; j < 4; ++j)
-		{
-			auto at = [&](double di, double dj)
+	// differences in the log-scales) gives each scale's uncertainty. A
+	// sighting that crosses the gate between two evaluations makes the
+	// likelihood step, not curve: when the differences at one step are not
+	// a positive definite curvature, they are taken again at wider steps,
+	// which average over such steps.
+	const double f0 = r.after.neg_log_likelihood + prior(best);
+	auto hessian = [&](double h)
+	{
+		Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+		for (int i = 0; i < 4; ++i)
+			for (int j = i; j < 4; ++j)
 			{
-				Eigen::Vector4d v = best;
-				v[i] += di;
-				v[j] += dj;
-				++r.evaluations;
-				return f(v);
-			};
-			H(i, j) = H(j, i) = i == j
-									? (at(h, 0) - 2 * f0 + at(-h, 0)) / (h * h)
-									: (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4 * h * h);
-		}
+				auto at = [&](double di, double dj)
+				{
+					Eigen::Vector4d v = best;
+					v[i] += di;
+					v[j] += dj;
+					++r.evaluations;
+					return f(v);
+				};
+				H(i, j) = H(j, i) =
+					i == j ? (at(h, 0) - 2 * f0 + at(-h, 0)) / (h * h)
+						   : (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4 * h * h);
+			}
+		return H;
+	};
+	auto positiveDefinite = [](const Eigen::Matrix4d& H)
+	{
+		return H.allFinite() &&
+			   Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(H).eigenvalues().minCoeff() > 0;
+	};
+	Eigen::Matrix4d H;
+	for (const double h : {0.05, 0.15, 0.4})
+		if (positiveDefinite(H = hessian(h))) break;
 	if (progress) progress(1.0);
 	const char* names[4] = {"sigma_px", "growth_x_px", "sigma_y_px", "growth_y_px"};
-	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(H);
-	if (!(es.eigenvalues().minCoeff() > 0) || !H.allFinite())
+	if (!positiveDefinite(H))
 	{
 		r.relative_std.setConstant(std::numeric_limits<double>::infinity());
 		r.warnings.emplace_back(
