@@ -10,22 +10,26 @@
 # with the start and the default for reference. The loops' odometry is a
 # fine wheel odometry (0.5% of the distance; floors 0.5 mm, 0.02 deg per
 # reading), where the innovations see the sightings' noise (docs/design.md).
-# Writes docs/benchmarks/noise.md.
+# Then the NIS verdict over SEEDS seeds (default 10) of the same loop in the
+# project's renderer's linear light, for every filter, with that source's
+# own calibration (realistic) and with it 5x too small (C_P / 25) and 3x too
+# large (C_P x 9). Writes docs/benchmarks/noise.md.
 #
 # Usage: scripts/bench-noise.sh [--presets LIST] [--no-povray]
 # Environment: BUILD_DIR (default build-bench), WORK (scratch folder),
-# START_DIVISOR.
+# START_DIVISOR, SEEDS.
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$ROOT/build-bench}"
 WORK="${WORK:-/tmp/codemark_bench_noise}"
 START_DIVISOR="${START_DIVISOR:-3}"
+SEEDS="${SEEDS:-10}"
 DOC="$ROOT/docs/benchmarks/noise.md"
 presets="webcam,phone"
 povray=1
 while [[ $# -gt 0 ]]; do
 	case "$1" in
-		-h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+		-h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 		--presets) presets="$2"; shift 2 ;;
 		--no-povray) povray=0; shift ;;
 		*) echo "bench-noise.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
@@ -36,8 +40,8 @@ if [[ $povray -eq 1 ]] && ! command -v povray >/dev/null; then
 	exit 1
 fi
 cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DCODEMARK_BUILD_BENCH=ON >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)" --target codemark-simul codemark-localize \
-	codemark-calibrate-noise >/dev/null
+cmake --build "$BUILD_DIR" -j"$(nproc)" --target codemark-simul codemark-annotate \
+	codemark-localize codemark-calibrate-noise >/dev/null
 bin="$BUILD_DIR/apps"
 share="$ROOT/share/codemark"
 mkdir -p "$WORK"
@@ -56,14 +60,14 @@ echo "$odometry" >"$WORK/own.ini"
 printf '[trajectory]\nloops = 2\n[dataset]\nframe_rate_hz = 5\n[render]\nbackground = Textured\n%s\n' \
 	"$odometry" >"$WORK/povray.ini"
 
+# A shipped calibration with every sigma multiplied: scaled NAME FACTOR OUT.
+scaled() {
+	"$bin/codemark-calibrate-noise/codemark-calibrate-noise" --calibration "$1" --scale "$2" \
+		-o "$3" >/dev/null
+}
 # The start: the default calibration with every sigma divided.
 start="$WORK/start.ini"
-awk -v f="$START_DIVISOR" '
-	/^(sigma_px|sigma_y_px|growth_x_px|growth_y_px|clipped_side_sigma_px) = / { print $1 " = " $3 / f; next }
-	/^(sigma_x_table|sigma_y_table|noise_sigma_x_table|noise_sigma_y_table) = ./ {
-		line = $1 " ="; for (i = 3; i <= NF; ++i) { split($i, p, ":"); line = line " " p[1] ":" p[2] / f }
-		print line; next }
-	{ print }' "$share/calibration/family.ini" >"$start"
+scaled family "$(awk -v d="$START_DIVISOR" 'BEGIN { print 1 / d }')" "$start"
 
 # summary.json's value of KEY (a list's items joined by ", ").
 json() {
@@ -121,6 +125,56 @@ if [[ $povray -eq 1 ]]; then
 	for p in "${names[@]}"; do run_set "povray-$p" povray "$p"; done
 fi
 
+# The verdicts over the seeds: linear light (realistic is that source's
+# own calibration), every filter, three calibrations.
+scaled realistic 0.2 "$WORK/realistic-small.ini"
+scaled realistic 3 "$WORK/realistic-large.ini"
+declare -A verdicts ratios
+for seed in $(seq 1 "$SEEDS"); do
+	dir="$WORK/linear/seed$seed"
+	if [[ ! -f "$dir/annotated.rawlog" ]]; then
+		mkdir -p "$dir"
+		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" -o "$dir" >&2
+		"$bin/codemark-annotate/codemark-annotate" -q -i "$dir/dataset.rawlog" \
+			-o "$dir/annotated.rawlog" --map "$dir/map.txt" --calibration realistic --drop-images >&2
+	fi
+	for cal in own small large; do
+		c=realistic
+		[[ $cal == small ]] && c="$WORK/realistic-small.ini"
+		[[ $cal == large ]] && c="$WORK/realistic-large.ini"
+		for method in ekf ekf-pose ekf-slam pf; do
+			out="$dir/out-$cal-$method"
+			"$bin/codemark-localize/codemark-localize" -q -c "$share/config/$method.ini" \
+				--method "$method" -r "$dir/annotated.rawlog" -m "$dir/map.txt" \
+				-g "$dir/gt_path.txt" --calibration "$c" -o "$out" >/dev/null
+			v=$(json "$out/summary.json" nis_verdict)
+			case "$v" in
+				consistent) v=consistent ;;
+				"covariances too small"*) v=small ;;
+				"covariances too large"*) v=large ;;
+				*) v=other ;;
+			esac
+			verdicts[$method,$cal]+="$v "
+			ratios[$method,$cal]+="$(awk -v a="$(json "$out/summary.json" nis_mean)" \
+				-v d="$(json "$out/summary.json" nis_dof)" 'BEGIN{printf "%.2f", a/d}') "
+		done
+	done
+	echo "bench-noise.sh: verdicts, seed $seed done" >&2
+done
+verdict_rows=()
+for method in ekf ekf-pose ekf-slam pf; do
+	for cal in own small large; do
+		read -r -a v <<<"${verdicts[$method,$cal]}"
+		count() { local n=0 x; for x in "${v[@]}"; do [[ $x == "$1" ]] && n=$((n + 1)); done; echo "$n"; }
+		label="realistic (own)"
+		want=consistent
+		[[ $cal == small ]] && label="realistic / 5 (C_P / 25)" && want=small
+		[[ $cal == large ]] && label="realistic x 3 (C_P x 9)" && want=large
+		range=$(tr ' ' '\n' <<<"${ratios[$method,$cal]}" | sed '/^$/d' | sort -g | sed -n '1p;$p' | paste -sd- -)
+		verdict_rows+=("| $method | $label | $(count "$want") / ${#v[@]} | $(count consistent) | $(count small) | $(count large) | $range |")
+	done
+done
+
 mkdir -p "$(dirname "$DOC")"
 {
 	echo "# Sighting noise calibrated from a run"
@@ -160,5 +214,18 @@ mkdir -p "$(dirname "$DOC")"
 	echo "| dataset | run | calibration | method | ATE [cm] | NEES [95% band] | NIS/DoF | visits | verdict | gated [%] |"
 	echo "|---|---|---|---|---|---|---|---|---|---|"
 	printf '%s\n' "${rows[@]}"
+	echo
+	echo "## The verdict over $SEEDS seeds"
+	echo
+	echo "codemark-simul's room loop (one lap, 5 Hz, the fine odometry above) in the"
+	echo "project's renderer's linear light, seeds 1 to $SEEDS, annotated with that source's"
+	echo "own calibration (\`realistic\`) and localized by every filter from an unknown"
+	echo "start with it, with every sigma 5x smaller and 3x larger (\`codemark-localize"
+	echo "--calibration\` measures each sighting again). \"right\": runs whose"
+	echo "verdict says what the calibration is (consistent, too small, too large)."
+	echo
+	echo "| filter | calibration | right | consistent | too small | too large | NIS/DoF range |"
+	echo "|---|---|---|---|---|---|---|"
+	printf '%s\n' "${verdict_rows[@]}"
 } >"$DOC"
 echo "bench-noise.sh: wrote $DOC" >&2
