@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <set>
 
 #include "bench.h"
@@ -84,63 +85,44 @@ JobResult runJob(
 	{
 		if (seed) reseedMrptRandom(*seed);
 		const std::string ini = cfg.config_dir + "/" + method + ".ini";
-		mrpt::config::CConfigFile mcfg(ini);
-		auto& s = r.summary;
-		s.method = method;
+		if (!std::ifstream(ini).good()) throw std::runtime_error(ini + ": cannot open config file");
 		const bool mrpt_map = filters::isMrptLandmarksFile(ds.map);
-		const LandmarkMap map =
-			mrpt_map ? filters::loadMrptLandmarksFile(ds.map) : LandmarkMap::load(ds.map);
-		const eval::GroundTruth gt = eval::GroundTruth::load(ds.gt);
+		const LandmarkMap map = filters::loadAnyMap(ds.map);
 		std::optional<CameraModel> camera;
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
+		// The stepper drops sightings seen beyond this angle: not expected.
+		const double max_view_angle_deg =
+			filters::readingOptions(mrpt::config::CConfigFile(ini), ds.calibration, std::nullopt)
+				.stepper.max_view_angle_deg;
 
-		auto [so, po] = filters::readingOptions(
-			mcfg, ds.calibration, mrpt_map ? std::nullopt : std::optional(map));
-		po.camera_override = camera;
-
+		eval::LocalizeRequest req;
+		req.config_file = ini;
+		req.rawlog = ds.rawlog;
+		req.method = method;
 		// ekf-slam builds its own map: the dataset's map is its ground truth
-		// (for the plots and the detection rate), not a prior.
-		const LandmarkMap prior = method == "ekf-slam" ? LandmarkMap() : map;
-		auto filter = filters::makeLocalizer(method, mcfg, prior, filters::initialPose(mcfg));
-		filters::RawlogStepper stepper(ds.rawlog, so, po);
-		filters::RawlogStep step;
-		double filter_s = 0, detect_s = 0;
-		auto t_read = Clock::now();
-		while (true)
-		{
-			const bool more = stepper.next(step);
-			const auto t0 = Clock::now();
-			if (!more) break;
-			if (step.images_detected > 0)
+		// (landmark errors, plots, per-ID scales), not a prior.
+		(method == "ekf-slam" ? req.gt_map_file : req.map_file) = ds.map;
+		req.gt_file = ds.gt;
+		req.out_dir = out_dir;
+		req.calibration = ds.calibration;
+		req.camera_file = ds.camera;
+		r.summary = eval::runLocalization(
+			req, progress,
+			[&](const filters::RawlogStep& step, const eval::LocalizeSummary& so_far,
+				const LandmarkMap&, const filters::Localizer&)
 			{
 				r.detection.images += step.images_detected;
-				detect_s += seconds(t_read, t0);
-			}
-			const filters::StepStats st = filter->step(step.odometry.get(), step.observations);
-			filter_s += seconds(t0, Clock::now());
-			const auto truth = gt.poseAt(step.index, step.timestamp, 1e-3, step.actions);
-			if (truth && !mrpt_map)
-				for (const auto& o : step.observations)
-					if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
-						tallyDetections(
-							*lm, *truth, map, camera, cfg.min_span_px, so.max_view_angle_deg,
-							r.detection);
-			eval::appendStep(s, step, st, filter->estimate(), truth);
-			if (progress) progress(stepper.progress());
-			t_read = Clock::now();
-		}
-		s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
-		s.detect_ms_per_image = r.detection.images ? 1000.0 * detect_s / r.detection.images : 0.0;
-		r.detection.detect_ms_per_image = s.detect_ms_per_image;
-		s.slam_map = filter->landmarks();
-		// SLAM without a prior map estimates in the frame of the robot's
-		// start: its ATE and NEES after the alignment (NEES anchored at the
-		// true first pose), as codemark-localize reports them.
-		s.metrics = eval::computeMetrics(s.rows, prior.landmarks.empty());
-		eval::summariseInnovations(s);
-		r.rpe = eval::relativePoseError(s.rows, cfg.rpe_interval_s);
-		r.aligned = eval::alignPath(s.rows);
-		eval::writeOutputs(s, map, out_dir);
+				const auto& truth = so_far.rows.back().truth;
+				if (truth && !mrpt_map)
+					for (const auto& o : step.observations)
+						if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
+							tallyDetections(
+								*lm, *truth, map, camera, cfg.min_span_px, max_view_angle_deg,
+								r.detection);
+			});
+		r.detection.detect_ms_per_image = r.summary.detect_ms_per_image;
+		r.rpe = eval::relativePoseError(r.summary.rows, cfg.rpe_interval_s);
+		r.aligned = eval::alignPath(r.summary.rows);
 		r.ok = true;
 	}
 	catch (const std::exception& e)

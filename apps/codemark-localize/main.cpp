@@ -105,11 +105,6 @@ int main(int argc, char** argv)
 			if (!req.gt_file.empty()) gt_path = codemark::eval::GroundTruth::load(req.gt_file);
 			view = std::make_unique<codemark::app::LiveView>(gui_every.getValue(), gt_path);
 		}
-		codemark::eval::StepObserver on_step;
-		if (view)
-			on_step = [&](const codemark::eval::LocalizeSummary& so_far,
-						  const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
-			{ view->update(so_far, m, f); };
 		// The label names the method: two runs over one rawlog (the demo's
 		// ekf and pf) draw distinguishable progress lines.
 		std::string method_name = req.method;
@@ -120,16 +115,17 @@ int main(int argc, char** argv)
 			"codemark-localize" + (method_name.empty() ? "" : " (" + method_name + ")"),
 			!quiet.getValue());
 		codemark::LandmarkMap used_map;
+		codemark::eval::StepObserver on_step;
+		if (view)
+			on_step = [&](const codemark::filters::RawlogStep&,
+						  const codemark::eval::LocalizeSummary& so_far,
+						  const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
+			{
+				used_map = m;
+				view->update(so_far, m, f);
+			};
 		const auto s = codemark::eval::runLocalization(
-			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); },
-			view ? codemark::eval::StepObserver(
-					   [&](const codemark::eval::LocalizeSummary& so_far,
-						   const codemark::LandmarkMap& m, const codemark::filters::Localizer& f)
-					   {
-						   used_map = m;
-						   on_step(so_far, m, f);
-					   })
-				 : codemark::eval::StepObserver());
+			req, [&](double f) { bar.update(static_cast<long>(1000 * f), 1000); }, on_step);
 		bar.finish();
 		if (s.steps == 0)
 			throw std::runtime_error(

@@ -3,6 +3,7 @@
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/eval/localization.h>
 #include <codemark/filters/stepper.h>
+#include <codemark/landmark/camera.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -549,10 +550,18 @@ LocalizeSummary runLocalization(
 			"' needs at least one)");
 	std::optional<GroundTruth> gt;
 	if (!req.gt_file.empty()) gt = GroundTruth::load(req.gt_file);
+	LandmarkMap gt_map;
+	if (!req.gt_map_file.empty()) gt_map = loadAnyMap(req.gt_map_file);
 
-	const bool spec_map = !req.map_file.empty() && !isMrptLandmarksFile(req.map_file);
-	const auto [so, po] =
-		readingOptions(cfg, req.calibration, spec_map ? std::optional(map) : std::nullopt);
+	// The landmarks' per-ID scales: the map's, else (SLAM) the true map's.
+	std::optional<LandmarkMap> sizes;
+	if (!req.map_file.empty() && !isMrptLandmarksFile(req.map_file))
+		sizes = map;
+	else if (
+		req.map_file.empty() && !req.gt_map_file.empty() && !isMrptLandmarksFile(req.gt_map_file))
+		sizes = gt_map;
+	auto [so, po] = readingOptions(cfg, req.calibration, sizes);
+	if (!req.camera_file.empty()) po.camera_override = CameraModel::load(req.camera_file);
 
 	auto filter = makeLocalizer(s.method, cfg, map, initialPose(cfg));
 	RawlogStepper stepper(req.rawlog, so, po);
@@ -590,7 +599,7 @@ LocalizeSummary runLocalization(
 			s, step, st, filter->estimate(),
 			gt ? gt->poseAt(step.index, step.timestamp, 1e-3, step.actions) : std::nullopt);
 		if (progress) progress(stepper.progress());
-		if (on_step) on_step(s, map, *filter);
+		if (on_step) on_step(step, s, map, *filter);
 		t_read = std::chrono::steady_clock::now();
 	}
 	s.time_per_step_ms = s.steps ? 1000.0 * filter_s / s.steps : 0.0;
@@ -600,12 +609,10 @@ LocalizeSummary runLocalization(
 	// SLAM without a prior map estimates in the frame of the robot's start:
 	// align it to the ground truth's before comparing.
 	s.metrics = computeMetrics(s.rows, slam && map.landmarks.empty());
+	// Landmark errors against the true map, in the same alignment.
 	if (s.metrics && slam && !req.gt_map_file.empty())
-	{
-		// Landmark errors against the true map, in the same alignment.
-		addLandmarkErrors(*s.metrics, s.slam_map, loadAnyMap(req.gt_map_file));
-	}
-	if (!req.out_dir.empty()) writeOutputs(s, map, req.out_dir);
+		addLandmarkErrors(*s.metrics, s.slam_map, gt_map);
+	if (!req.out_dir.empty()) writeOutputs(s, map.landmarks.empty() ? gt_map : map, req.out_dir);
 	return s;
 }
 

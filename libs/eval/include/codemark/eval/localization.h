@@ -31,8 +31,10 @@ struct LocalizeRequest
 		method;	 //!< ekf | ekf-pose | ekf-slam | pf; empty: the ini's [localize] method, else ekf
 	std::string gt_file;  //!< ground truth (either form of spec section 6); may be empty
 	/** SLAM: the true landmark map (spec section 3 or MRPT's landmark file)
-	 * for summary.json's landmark_rmse_m; may be empty. */
+	 * for summary.json's landmark_rmse_m, the plots and, without map_file,
+	 * the landmarks' per-ID scales; may be empty. */
 	std::string gt_map_file;
+	std::string camera_file;  //!< when set, replaces the camera stored in the rawlog
 	std::string out_dir;  //!< output folder (created)
 	/** C_P's calibration (a file or a shipped calibration's name,
 	 * pipeline::calibratedPoseOptions()); the config's [pose] keys override
@@ -44,12 +46,14 @@ struct LocalizeRequest
 
 struct LocalizeSummary;
 
-/** Called after each step of runLocalization (live views): the summary so
- * far (its rows up to this step; metrics not yet computed), the map in use
- * (empty for SLAM without a prior map) and the filter (e.g. its
- * landmarks()). */
+/** Called after each step of runLocalization (live views, benchmarks'
+ * detection tallies): the step as read (its observations, images detected
+ * in it), the summary so far (its rows up to this step, the last with its
+ * matched ground truth; metrics not yet computed), the map in use (empty
+ * for SLAM without a prior map) and the filter (e.g. its landmarks()). */
 using StepObserver = std::function<void(
-	const LocalizeSummary& so_far, const LandmarkMap& map, const filters::Localizer& filter)>;
+	const filters::RawlogStep& step, const LocalizeSummary& so_far, const LandmarkMap& map,
+	const filters::Localizer& filter)>;
 
 /** One processed camera frame. */
 struct PathRow
