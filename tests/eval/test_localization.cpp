@@ -199,6 +199,12 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 		  "nees_band_95", "nis_mean", "nis_dof", "nis_count", "gated_fraction", "nis_verdict"})
 		EXPECT_TRUE(parsed.contains(k)) << k;
 	EXPECT_EQ(parsed["nees_band_95"].size(), 2u);
+	EXPECT_TRUE(parsed["calibration"].is_null()) << "no --calibration: stored covariances";
+	// With a calibration, summary.json names the file that measured.
+	LocalizeSummary with_cal;
+	with_cal.method = "ekf";
+	with_cal.calibration = "/some/where/plain.ini";
+	EXPECT_EQ(nlohmann::json::parse(summaryJson(with_cal))["calibration"], with_cal.calibration);
 
 	// Bad input: one error naming the file.
 	req.map_file = writeText("badmap.txt", "1 2 3\n");

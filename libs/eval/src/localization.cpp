@@ -4,6 +4,7 @@
 #include <codemark/eval/localization.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/landmark/camera.h>
+#include <codemark/pose/calibration.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/exceptions.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -444,6 +445,10 @@ std::string summaryJson(const LocalizeSummary& s)
 	};
 	nlohmann::ordered_json j;
 	j["method"] = s.method;
+	if (s.calibration.empty())
+		j["calibration"] = nullptr;
+	else
+		j["calibration"] = s.calibration;
 	j["steps"] = s.steps;
 	j["sightings_used"] = s.sightings_used;
 	j["sightings_rejected"] = s.sightings_rejected;
@@ -538,6 +543,7 @@ LocalizeSummary runLocalization(
 	mrpt::config::CConfigFile cfg(req.config_file);
 	LocalizeSummary s;
 	s.method = !req.method.empty() ? req.method : cfg.read_string("localize", "method", "ekf");
+	if (!req.calibration.empty()) s.calibration = pose::resolveCalibration(req.calibration);
 	const bool slam = s.method == "ekf-slam";
 	LandmarkMap map;
 	if (!req.map_file.empty())

@@ -104,6 +104,11 @@ struct PathMetrics
 struct LocalizeSummary
 {
 	std::string method;
+	/** The calibration file that measured the sightings (resolved from
+	 * LocalizeRequest::calibration); empty when none was given: images are
+	 * detected with the default calibration and annotated sightings keep
+	 * their stored covariances. */
+	std::string calibration;
 	long steps = 0;	 //!< processed camera frames
 	long sightings_used = 0, sightings_rejected = 0, sightings_unknown_id = 0;
 	/** Coded sightings dropped before the filter as seen beyond
