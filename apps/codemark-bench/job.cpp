@@ -1,7 +1,6 @@
 // codemark-bench: one job = one dataset through one method, its metrics
 // (libs/eval) and the detection rate against the ground truth.
 #include <codemark/landmark/random.h>
-#include <codemark/eval/ground_truth.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/stepper.h>
 #include <codemark/pose/closed_form.h>
@@ -10,10 +9,7 @@
 #include <codemark/sim/frames.h>
 #include <codemark/sim/render.h>
 #include <mrpt/config/CConfigFile.h>
-#include <mrpt/math/wrap2pi.h>
-#include <mrpt/random/RandomGenerators.h>
 
-#include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -90,10 +86,9 @@ JobResult runJob(
 		const LandmarkMap map = filters::loadAnyMap(ds.map);
 		std::optional<CameraModel> camera;
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
-		// The stepper drops sightings seen beyond this angle: not expected.
-		const double max_view_angle_deg =
-			filters::readingOptions(mrpt::config::CConfigFile(ini), ds.calibration, std::nullopt)
-				.stepper.max_view_angle_deg;
+		// The stepper drops sightings seen beyond its max_view_angle_deg: not expected.
+		filters::StepperOptions stepper;
+		stepper.loadFromConfigFile(mrpt::config::CConfigFile(ini), "stepper");
 
 		eval::LocalizeRequest req;
 		req.config_file = ini;
@@ -117,8 +112,8 @@ JobResult runJob(
 					for (const auto& o : step.observations)
 						if (auto lm = std::dynamic_pointer_cast<CObservationCodedLandmarks>(o))
 							tallyDetections(
-								*lm, *truth, map, camera, cfg.min_span_px, max_view_angle_deg,
-								r.detection);
+								*lm, *truth, map, camera, cfg.min_span_px,
+								stepper.max_view_angle_deg, r.detection);
 			});
 		r.detection.detect_ms_per_image = r.summary.detect_ms_per_image;
 		r.rpe = eval::relativePoseError(r.summary.rows, cfg.rpe_interval_s);

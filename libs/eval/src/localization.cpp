@@ -92,22 +92,9 @@ std::optional<RelativePoseError> relativePoseError(
 
 std::optional<PathAlignment> alignPath(const std::vector<PathRow>& rows)
 {
-	std::vector<Eigen::Vector2d> e, g;
-	for (const auto& r : rows)
-		if (r.estimate.initialized && r.truth)
-		{
-			e.emplace_back(r.estimate.mean.x(), r.estimate.mean.y());
-			g.emplace_back(r.truth->x(), r.truth->y());
-		}
-	if (e.size() < 2) return std::nullopt;
-	PathAlignment a;
-	a.truth_T_estimate = alignSE2(e, g);
-	const Eigen::Rotation2Dd R(a.truth_T_estimate.phi());
-	const Eigen::Vector2d t(a.truth_T_estimate.x(), a.truth_T_estimate.y());
-	double s = 0;
-	for (std::size_t i = 0; i < e.size(); ++i) s += (R * e[i] + t - g[i]).squaredNorm();
-	a.ate_m = std::sqrt(s / static_cast<double>(e.size()));
-	return a;
+	const auto m = computeMetrics(rows, true);
+	if (!m || m->matched < 2) return std::nullopt;
+	return PathAlignment{m->truth_T_estimate, m->ate_rmse_m};
 }
 
 std::optional<PathMetrics> computeMetrics(const std::vector<PathRow>& rows, bool align_se2)

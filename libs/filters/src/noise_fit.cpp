@@ -335,11 +335,12 @@ NoiseFitResult fitSightingNoise(
 			   Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(H).eigenvalues().minCoeff() > 0;
 	};
 	Eigen::Matrix4d H;
+	bool curved = false;
 	for (const double h : {0.05, 0.15, 0.4})
-		if (positiveDefinite(H = hessian(h))) break;
+		if ((curved = positiveDefinite(H = hessian(h)))) break;
 	if (progress) progress(1.0);
 	const char* names[4] = {"sigma_px", "growth_x_px", "sigma_y_px", "growth_y_px"};
-	if (!positiveDefinite(H))
+	if (!curved)
 	{
 		r.relative_std.setConstant(std::numeric_limits<double>::infinity());
 		r.warnings.emplace_back(
