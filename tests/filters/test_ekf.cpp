@@ -157,6 +157,61 @@ TEST_P(BothVariants, GlobalInitialisationFromOneLandmark)
 	EXPECT_LT((e.cov - C).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The first fix waits for a tight estimate: a far landmark's single pose fix
+// is wide along its arc, so the filter runs from it while estimate() reports
+// no fix until the position and yaw standard deviations are under
+// converged_std_*; the fix then stays, however the covariance grows.
+TEST_P(BothVariants, FirstFixWaitsForATightEstimate)
+{
+	const LandmarkMap map = roomMap();
+	const CPose2D truth(1.5, 3.1, 0.05);  // 4.5 m from landmark 2
+	const auto cam = cameraOnRobot();
+	const Eigen::Vector3d wide(0.01, 0.002, 0.1);
+	const auto std_xy = [](const PoseEstimate& e)
+	{
+		return std::sqrt(
+			Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(e.cov.topLeftCorner<2, 2>())
+				.eigenvalues()
+				.maxCoeff());
+	};
+	EkfOptions o;
+	auto f = makeEkfLocalizer(GetParam(), o, map);
+	std::mt19937 rng(3);
+	auto st = f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[1], wide, &rng)}));
+	EXPECT_TRUE(st.reinitialized);
+	ASSERT_FALSE(f->estimate().initialized);
+	ASSERT_GT(std_xy(f->estimate()), o.converged_std_xy_m) << "the test needs a wide first fix";
+	int fixed_at = -1;
+	for (int k = 1; k < 40 && fixed_at < 0; ++k)
+	{
+		f->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[1], wide, &rng)}));
+		const auto e = f->estimate();
+		const bool tight = std_xy(e) < o.converged_std_xy_m &&
+						   std::sqrt(e.cov(2, 2)) < o.converged_std_yaw_deg * M_PI / 180;
+		EXPECT_EQ(e.initialized, tight) << "step " << k;
+		if (e.initialized) fixed_at = k;
+	}
+	ASSERT_GT(fixed_at, 1);
+	// Sticky: odometry without sightings widens the covariance past the
+	// thresholds; the estimate stays a fix.
+	const auto odo = odometry(CPose2D(0.1, 0, 0), 0.2, 0.2);
+	for (int k = 0; k < 5; ++k) f->step(&odo, mrpt::obs::CSensoryFrame());
+	EXPECT_GT(std_xy(f->estimate()), o.converged_std_xy_m);
+	EXPECT_TRUE(f->estimate().initialized);
+
+	// Wide thresholds: the first sighting is the fix.
+	o.converged_std_xy_m = 10;
+	o.converged_std_yaw_deg = 180;
+	auto g = makeEkfLocalizer(GetParam(), o, map);
+	g->step(nullptr, frameOf({sighting(truth, cam, map.landmarks[1], wide)}));
+	EXPECT_TRUE(g->estimate().initialized);
+	// A known initial pose is a fix from the start.
+	auto h = makeEkfLocalizer(GetParam(), EkfOptions(), map, guess(truth, 0.5, 0.5));
+	EXPECT_TRUE(h->estimate().initialized);
+	o.converged_std_xy_m = 0;
+	EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
 TEST_P(BothVariants, AngleWrapAcrossPi)
 {
 	// Robot heading pi - 0.01, facing landmark 3 on the wall x = 0.

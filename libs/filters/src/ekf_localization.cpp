@@ -37,6 +37,8 @@ void EkfOptions::validate() const
 	if (!(iterations >= 1 && iterations <= 100)) bad("iterations", "must be in [1, 100]");
 	if (!(pd_tolerance >= 0)) bad("pd_tolerance", "must be >= 0");
 	if (!(min_eigenvalue > 0)) bad("min_eigenvalue", "must be > 0");
+	if (!(converged_std_xy_m > 0)) bad("converged_std_xy_m", "must be > 0");
+	if (!(converged_std_yaw_deg > 0)) bad("converged_std_yaw_deg", "must be > 0");
 }
 
 void EkfOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
@@ -49,6 +51,8 @@ void EkfOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, cons
 	MRPT_LOAD_CONFIG_VAR(iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(pd_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_eigenvalue, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(converged_std_xy_m, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(converged_std_yaw_deg, double, c, s);
 	validate();
 }
 
@@ -62,6 +66,8 @@ void EkfOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::s
 	c.write(s, "iterations", iterations, -1, -1);
 	c.write(s, "pd_tolerance", pd_tolerance, -1, -1);
 	c.write(s, "min_eigenvalue", min_eigenvalue, -1, -1);
+	c.write(s, "converged_std_xy_m", converged_std_xy_m, -1, -1);
+	c.write(s, "converged_std_yaw_deg", converged_std_yaw_deg, -1, -1);
 }
 
 Eigen::Vector3d predictLandmarkMeasurement(
@@ -174,7 +180,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 			Eigen::Matrix3d P = initial->cov;
 			symmetriseAndCheckCovariance(P, opt_.pd_tolerance, opt_.min_eigenvalue, "initial pose");
 			setState({initial->mean.x(), initial->mean.y(), initial->mean.phi()}, P);
-			initialized_ = true;
+			initialized_ = converged_ = true;
 		}
 	}
 
@@ -186,7 +192,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	PoseEstimate estimate() const override
 	{
 		PoseEstimate e;
-		e.initialized = initialized_;
+		e.initialized = converged_;
 		e.mean = CPose2D(m_xkk[0], m_xkk[1], m_xkk[2]);
 		e.cov = m_pkk.asEigen().block<3, 3>(0, 0);
 		return e;
@@ -195,6 +201,22 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	StepStats step(
 		const mrpt::obs::CActionRobotMovement2D* odometry,
 		const mrpt::obs::CSensoryFrame& observations) override
+	{
+		StepStats st = filterStep(odometry, observations);
+		// The first fix (sticky, as the particle filter's): the estimate is
+		// reported once it is tight, not at the first sighting, whose single
+		// pose fix can be tens of centimetres wide at range.
+		if (initialized_ && !converged_)
+			converged_ = converged(
+				m_pkk.asEigen().block<3, 3>(0, 0), opt_.converged_std_xy_m,
+				mrpt::DEG2RAD(opt_.converged_std_yaw_deg));
+		return st;
+	}
+
+   private:
+	StepStats filterStep(
+		const mrpt::obs::CActionRobotMovement2D* odometry,
+		const mrpt::obs::CSensoryFrame& observations)
 	{
 		StepStats st;
 		predict_ = false;
@@ -283,7 +305,6 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 		return st;
 	}
 
-   private:
 	void setState(const Eigen::Vector3d& x, const Eigen::Matrix3d& P)
 	{
 		for (int i = 0; i < 3; ++i) m_xkk[i] = x[i];
@@ -501,6 +522,7 @@ class EkfLocalizer final : public Localizer, private mrpt::bayes::CKalmanFilterC
 	LandmarkMap map_;
 	double gate_;  // chi2inv(gate_probability, 3)
 	bool initialized_ = false;
+	bool converged_ = false;  // the first fix (estimate().initialized)
 	int consecutive_rejections_ = 0;
 
 	// The iteration in progress.

@@ -4,6 +4,7 @@
 #include <mrpt/math/distributions.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -88,6 +89,14 @@ std::string nisVerdict(double nis_mean, double nis_dof, long count)
 	else
 		o << "covariances too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
 	return o.str();
+}
+
+bool converged(const Eigen::Matrix3d& cov, double std_xy_m, double std_yaw_rad)
+{
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov.topLeftCorner<2, 2>());
+	const double std_xy = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+	const double std_yaw = std::sqrt(std::max(0.0, cov(2, 2)));
+	return std_xy < std_xy_m && std_yaw < std_yaw_rad;
 }
 
 }  // namespace codemark::filters

@@ -303,11 +303,8 @@ StepStats ParticleFilterLocalizer::step(
 	checkFinite(e);
 	if (!m_converged)
 	{
-		const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(e.cov.topLeftCorner<2, 2>());
-		const double std_xy = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
-		const double std_yaw = std::sqrt(std::max(0.0, e.cov(2, 2)));
 		m_converged =
-			std_xy < m_opts.converged_std_xy_m && std_yaw < m_opts.converged_std_yaw_deg * kDeg;
+			converged(e.cov, m_opts.converged_std_xy_m, m_opts.converged_std_yaw_deg * kDeg);
 	}
 	return stats;
 }

@@ -61,6 +61,12 @@ struct EkfOptions : public mrpt::config::CLoadableOptions
 	 * eigenvalues in between are raised to min_eigenvalue. */
 	double pd_tolerance = 1e-9;
 	double min_eigenvalue = 1e-12;	//!< floor of the covariance's eigenvalues [m^2 or rad^2]
+	/** The first fix (PoseEstimate::initialized): once the largest position
+	 * standard deviation is below converged_std_xy_m [m] and the yaw's below
+	 * converged_std_yaw_deg [deg], as the particle filter's; the filter
+	 * itself runs from its first sighting. */
+	double converged_std_xy_m = 0.15;
+	double converged_std_yaw_deg = 5;  //!< see converged_std_xy_m
 
 	/** Throws std::invalid_argument naming the bad key. */
 	void validate() const;

@@ -24,7 +24,11 @@ namespace codemark::filters
 /** The robot's pose estimate in the map frame. */
 struct PoseEstimate
 {
-	bool initialized = false;  //!< false until a first fix (global initialisation)
+	/** false until the first fix: the first estimate whose position and yaw
+	 * standard deviations are below the filter's converged_std_xy_m and
+	 * converged_std_yaw_deg (converged(); every localization filter), or a
+	 * known initial pose. The path and the metrics start there. */
+	bool initialized = false;
 	mrpt::poses::CPose2D mean;	//!< x, y [m], yaw [rad]
 	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();	//!< covariance of (x, y, yaw)
 };
@@ -155,5 +159,10 @@ constexpr double kNisConsistentLow = 0.5, kNisConsistentHigh = 2.0;
  * about (1/K)x" (K < 0.5), K with 2 significant digits; "no sightings tested"
  * when \a count is 0. */
 std::string nisVerdict(double nis_mean, double nis_dof, long count);
+
+/** Whether a pose covariance \a cov of (x, y, yaw) is a fix: the largest
+ * position standard deviation (the x-y block's largest eigenvalue) below
+ * \a std_xy_m and the yaw's below \a std_yaw_rad. */
+bool converged(const Eigen::Matrix3d& cov, double std_xy_m, double std_yaw_rad);
 
 }  // namespace codemark::filters
