@@ -169,10 +169,9 @@ TEST_P(BothVariants, FirstFixWaitsForATightEstimate)
 	const Eigen::Vector3d wide(0.01, 0.002, 0.1);
 	const auto std_xy = [](const PoseEstimate& e)
 	{
-		return std::sqrt(
-			Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(e.cov.topLeftCorner<2, 2>())
-				.eigenvalues()
-				.maxCoeff());
+		return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(e.cov.topLeftCorner<2, 2>())
+							 .eigenvalues()
+							 .maxCoeff());
 	};
 	EkfOptions o;
 	auto f = makeEkfLocalizer(GetParam(), o, map);
