@@ -50,8 +50,6 @@ print(100 * s["ate_rmse_m"], s["nees_mean"] / 3, s["nis_mean"] / s["nis_dof"])' 
 # (sigma_scale, floors) and the EKF's.
 inflation() {
   local seeds=10 seed source preset calibration variant
-  printf '[odometry]\nmotion_model = gaussian\ngaussian_alpha_1 = 0.005\ngaussian_alpha_2 = 0.001\ngaussian_alpha_3 = 0.005\ngaussian_alpha_4 = 0.01\ngaussian_min_std_xy = 0.0005\ngaussian_min_std_phi_deg = 0.02\n' \
-    >"$work/sim.ini"
   echo "## The likelihood's inflation"
   echo
   echo "codemark-simul's room loop (one lap, 5 Hz, fine wheel odometry: 0.5% of the distance), seeds 1"
@@ -73,28 +71,31 @@ inflation() {
       mkdir -p "$dir"
       local flags=(--preset "$preset")
       [[ $preset == default ]] && flags=()
-      "$apps/codemark-simul/codemark-simul" -q -c "$work/sim.ini" -s "$seed" "${flags[@]}" \
+      "$apps/codemark-simul/codemark-simul" -q -c bench/fine_odometry.ini -s "$seed" "${flags[@]}" \
         -o "$dir" >/dev/null
       "$apps/codemark-annotate/codemark-annotate" -q -i "$dir/dataset.rawlog" \
         -o "$dir/annotated.rawlog" --map "$dir/map.txt" --calibration "$calibration" \
         --drop-images >/dev/null
     done
-    local ekf_ate
-    ekf_ate=$(for seed in $(seq 1 $seeds); do
+    # The EKF's runs, once: its row and every row's ATE ratio.
+    local ekf_runs="$work/ekf-$preset.txt" ekf_ate
+    for seed in $(seq 1 $seeds); do
       localize ekf "$config/ekf.ini" "$work/$preset$seed" "$calibration"
-    done | awk '{ a += $1 } END { print a / NR }')
+    done >"$ekf_runs"
+    ekf_ate=$(awk '{ a += $1 } END { print a / NR }' "$ekf_runs")
     for variant in "ekf - -" "pf 1.5 0.01,0.5" "pf 1 0.01,0.5" "pf 1.5 0,0" "pf 1 0,0"; do
       read -r method scale floors <<<"$variant"
-      local cfg="$config/$method.ini"
-      if [[ $method == pf ]]; then
-        cfg="$work/pf-$scale-$floors.ini"
+      if [[ $method == ekf ]]; then
+        cat "$ekf_runs"
+      else
+        local cfg="$work/pf-$scale-$floors.ini"
         sed -e "s/^sigma_scale .*/sigma_scale = $scale/" \
           -e "s/^min_std_range_m .*/min_std_range_m = ${floors%,*}/" \
           -e "s/^min_std_angle_deg .*/min_std_angle_deg = ${floors#*,}/" "$config/pf.ini" >"$cfg"
-      fi
-      for seed in $(seq 1 $seeds); do
-        localize "$method" "$cfg" "$work/$preset$seed" "$calibration"
-      done | sort -k2,2g | awk -v src="$preset" -v m="$method" -v s="$scale" -v f="$floors" \
+        for seed in $(seq 1 $seeds); do
+          localize pf "$cfg" "$work/$preset$seed" "$calibration"
+        done
+      fi | sort -k2,2g | awk -v src="$preset" -v m="$method" -v s="$scale" -v f="$floors" \
         -v e="$ekf_ate" '
         { ate += $1; nees[NR] = $2; nis[NR] = $3; ok += ($3 >= 0.5 && $3 <= 2) }
         END {

@@ -48,14 +48,7 @@ mkdir -p "$WORK"
 start_time=$SECONDS
 
 # The fine odometry, for both renderers.
-odometry='[odometry]
-motion_model = gaussian
-gaussian_alpha_1 = 0.005
-gaussian_alpha_2 = 0.001
-gaussian_alpha_3 = 0.005
-gaussian_alpha_4 = 0.01
-gaussian_min_std_xy = 0.0005
-gaussian_min_std_phi_deg = 0.02'
+odometry="$(cat "$ROOT/bench/fine_odometry.ini")"
 echo "$odometry" >"$WORK/own.ini"
 printf '[trajectory]\nloops = 2\n[dataset]\nframe_rate_hz = 5\n[render]\nbackground = Textured\n%s\n' \
 	"$odometry" >"$WORK/povray.ini"
