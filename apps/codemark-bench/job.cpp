@@ -3,6 +3,7 @@
 #include <codemark/landmark/random.h>
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/stepper.h>
+#include <codemark/landmark/text.h>
 #include <codemark/pose/closed_form.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
@@ -88,7 +89,14 @@ JobResult runJob(
 		if (!ds.camera.empty()) camera = CameraModel::load(ds.camera);
 		// The stepper drops sightings seen beyond its max_view_angle_deg: not expected.
 		filters::StepperOptions stepper;
-		stepper.loadFromConfigFile(mrpt::config::CConfigFile(ini), "stepper");
+		try
+		{
+			stepper.loadFromConfigFile(mrpt::config::CConfigFile(ini), "stepper");
+		}
+		catch (const std::exception&)
+		{
+			rethrowNamingIniFile(ini);
+		}
 
 		eval::LocalizeRequest req;
 		req.config_file = ini;

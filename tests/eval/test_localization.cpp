@@ -13,6 +13,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "../filters/common.h"
 
@@ -216,6 +219,34 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 	catch (const std::exception& e)
 	{
 		EXPECT_NE(std::string(e.what()).find("badmap.txt"), std::string::npos) << e.what();
+	}
+
+	// A refused value in the config file: its file, line, section and key,
+	// for every filter's options and the stepper's.
+	req.map_file = (dir / "map.txt").string();
+	for (const auto& [text, where] : std::vector<std::pair<std::string, std::string>>{
+			 {"[localize]\nmethod = ekf\n[ekf]\n\ngate_probability = 2\n",
+			  ":5: [ekf] gate_probability: must be in (0, 1)"},
+			 {"[localize]\nmethod = ekf-pose\n[ekf]\nconverged_std_xy_m = 0\n",
+			  ":4: [ekf] converged_std_xy_m: must be > 0"},
+			 {"[localize]\nmethod = ekf\n[stepper]\nmax_view_angle_deg = -3\n",
+			  ":4: [stepper] max_view_angle_deg: must be > 0"},
+			 {"[localize]\nmethod = ekf-slam\n[ekf_slam]\nstd_sensor_range = 0\n",
+			  ":4: [ekf_slam] std_sensor_range: must be > 0"},
+			 {"[localize]\nmethod = pf\n[ParticleFilter]\nparticles_count = 0\n",
+			  ":4: [ParticleFilter] particles_count: must be > 0"}})
+	{
+		req.config_file = writeText("bad-key.ini", text);
+		try
+		{
+			runLocalization(req);
+			ADD_FAILURE() << "accepted: " << text;
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(req.config_file + where), std::string::npos)
+				<< e.what();
+		}
 	}
 }
 

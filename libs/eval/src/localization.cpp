@@ -3,6 +3,7 @@
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/eval/localization.h>
 #include <codemark/filters/stepper.h>
+#include <codemark/landmark/text.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/pose/calibration.h>
 #include <mrpt/config/CConfigFile.h>
@@ -553,10 +554,19 @@ LocalizeSummary runLocalization(
 	else if (
 		req.map_file.empty() && !req.gt_map_file.empty() && !isMrptLandmarksFile(req.gt_map_file))
 		sizes = gt_map;
-	auto [so, po] = readingOptions(cfg, req.calibration, sizes);
+	ReadingOptions reading;
+	std::unique_ptr<Localizer> filter;
+	try
+	{
+		reading = readingOptions(cfg, req.calibration, sizes);
+		filter = makeLocalizer(s.method, cfg, map, initialPose(cfg));
+	}
+	catch (const std::exception&)
+	{
+		rethrowNamingIniFile(req.config_file);	// "FILE:LINE: [SECTION] KEY: ..."
+	}
+	auto& [so, po] = reading;
 	if (!req.camera_file.empty()) po.camera_override = CameraModel::load(req.camera_file);
-
-	auto filter = makeLocalizer(s.method, cfg, map, initialPose(cfg));
 	RawlogStepper stepper(req.rawlog, so, po);
 	RawlogStep step;
 	double filter_s = 0;

@@ -41,7 +41,7 @@ double gateThreshold(double probability, unsigned dof)
 void EkfSlamOptions::validate() const
 {
 	auto bad = [](const char* key, const std::string& why)
-	{ throw std::invalid_argument(std::string("ekf-slam: [ekf_slam] ") + key + " " + why); };
+	{ throw std::invalid_argument(std::string("[ekf_slam] ") + key + ": " + why); };
 	if (!(gate_probability > 0.0 && gate_probability <= 1.0))
 		bad("gate_probability", "must be in (0, 1]");
 	if (!(std_sensor_range > 0.0)) bad("std_sensor_range", "must be > 0");
@@ -73,8 +73,7 @@ void EkfSlamOptions::loadFromConfigFile(
 			input = SlamInput::Both;
 		else
 			throw std::invalid_argument(
-				"ekf-slam: [" + s + "] input = '" + in +
-				"' (expected auto, coded, bearing_range or both)");
+				"[" + s + "] input = '" + in + "' (expected auto, coded, bearing_range or both)");
 	}
 	const std::string lm = c.read_string(s, "landmarks", "", false);
 	if (!lm.empty())
@@ -87,7 +86,7 @@ void EkfSlamOptions::loadFromConfigFile(
 			landmarks = SlamLandmarks::Point;
 		else
 			throw std::invalid_argument(
-				"ekf-slam: [" + s + "] landmarks = '" + lm + "' (expected auto, full or point)");
+				"[" + s + "] landmarks = '" + lm + "' (expected auto, full or point)");
 	}
 	MRPT_LOAD_CONFIG_VAR(gate_probability, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(std_sensor_range, double, c, s);

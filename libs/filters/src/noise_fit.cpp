@@ -4,6 +4,7 @@
 #include <codemark/filters/mrpt_landmarks.h>
 #include <codemark/filters/noise_fit.h>
 #include <codemark/filters/stepper.h>
+#include <codemark/landmark/text.h>
 #include <codemark/pipeline/pipeline.h>
 #include <mrpt/config/CConfigFile.h>
 
@@ -235,12 +236,23 @@ NoiseFitResult fitSightingNoise(
 		throw std::invalid_argument(req.map_file + ": the map has no landmarks");
 
 	// Annotated sightings are measured again: the fit changes C_P anyway.
-	auto [so, po] = readingOptions(
-		cfg, req.calibration.empty() ? pipeline::kDefaultCalibration : req.calibration,
-		isMrptLandmarksFile(req.map_file) ? std::nullopt : std::optional(map));
-	if (!req.camera_file.empty()) po.camera_override = CameraModel::load(req.camera_file);
+	ReadingOptions reading;
 	EkfOptions eo;
-	eo.loadFromConfigFile(cfg, "ekf");
+	std::optional<PoseEstimate> initial;
+	try
+	{
+		reading = readingOptions(
+			cfg, req.calibration.empty() ? pipeline::kDefaultCalibration : req.calibration,
+			isMrptLandmarksFile(req.map_file) ? std::nullopt : std::optional(map));
+		eo.loadFromConfigFile(cfg, "ekf");
+		initial = initialPose(cfg);
+	}
+	catch (const std::exception&)
+	{
+		rethrowNamingIniFile(req.config_file);	// "FILE:LINE: [SECTION] KEY: ..."
+	}
+	auto& [so, po] = reading;
+	if (!req.camera_file.empty()) po.camera_override = CameraModel::load(req.camera_file);
 
 	NoiseFitResult r;
 	std::vector<RawlogStep> steps;
@@ -270,7 +282,7 @@ NoiseFitResult fitSightingNoise(
 			req.rawlog + ": no sighting of a landmark of " + req.map_file +
 			" (nothing to calibrate from)");
 
-	const RunLikelihood run(std::move(steps), po, eo, map, initialPose(cfg));
+	const RunLikelihood run(std::move(steps), po, eo, map, initial);
 	r.before = run.evaluate(po.pose);
 	r.start = parametricNoiseModel(po.pose);
 	r.start_scales = noiseScales(r.start);

@@ -69,9 +69,7 @@ void ParticleFilterOptions::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(no_odometry_std_yaw_deg, double, c, s);
 	auto require = [&](bool ok, const char* key, const char* what)
 	{
-		if (!ok)
-			throw std::invalid_argument(
-				std::string("method 'pf': [") + s + "] " + key + " " + what);
+		if (!ok) throw std::invalid_argument(std::string("[") + s + "] " + key + ": " + what);
 	};
 	require(particles_count > 0, "particles_count", "must be > 0");
 	require(init_margin_m >= 0, "init_margin_m", "must be >= 0");
@@ -137,11 +135,11 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(
 	if (m_pf.m_options.adaptiveSampleSize &&
 		m_pf.m_options.resamplingMethod != mrpt::bayes::CParticleFilter::prMultinomial)
 		throw std::invalid_argument(
-			"method 'pf': [PF_options] adaptiveSampleSize=1 (KLD) needs resamplingMethod=0 "
+			"[PF_options] adaptiveSampleSize: 1 (KLD) needs resamplingMethod=0 "
 			"(prMultinomial)");
 	if (m_pf.m_options.PF_algorithm == mrpt::bayes::CParticleFilter::pfOptimalProposal)
 		throw std::invalid_argument(
-			"method 'pf': [PF_options] PF_algorithm=2 (pfOptimalProposal) is not offered by "
+			"[PF_options] PF_algorithm: 2 (pfOptimalProposal) is not offered by "
 			"CMonteCarloLocalization2D; use 0, 1 or 3");
 	if (m_opts.random_seed >= 0) reseedMrptRandom(static_cast<uint32_t>(m_opts.random_seed));
 	m_pdf.options.metricMap = m_map;

@@ -63,7 +63,7 @@ void StepperOptions::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(max_view_angle_deg, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(remeasure_sightings, bool, c, s);
 	if (!(max_view_angle_deg > 0))
-		throw std::invalid_argument("[" + s + "] max_view_angle_deg must be > 0 [deg]");
+		throw std::invalid_argument("[" + s + "] max_view_angle_deg: must be > 0 [deg]");
 }
 
 void StepperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const

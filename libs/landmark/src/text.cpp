@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -111,6 +112,45 @@ std::string oneLineMessage(const std::string& what)
 	return joined.empty() ? trim(what) : joined;
 }
 
+namespace
+{
+// True when \a msg begins "PATH: " or "PATH:LINE: " with PATH an existing
+// file (the error already names its own file, e.g. a calibration file read
+// while a config file loads).
+bool startsWithAFile(const std::string& msg)
+{
+	const auto colon = msg.find(": ");
+	if (colon == std::string::npos || colon == 0) return false;
+	std::string path = msg.substr(0, colon);
+	if (const auto c = path.rfind(':');
+		c != std::string::npos && c + 1 < path.size() &&
+		std::all_of(
+			path.begin() + static_cast<std::ptrdiff_t>(c) + 1, path.end(),
+			[](unsigned char ch) { return std::isdigit(ch); }))
+		path.resize(c);
+	std::error_code ec;
+	return std::filesystem::is_regular_file(path, ec);
+}
+
+// iniWhere() for a message that begins "[SECTION] KEY" (the options'
+// validators' convention: "[ekf] gate_probability: must be in (0, 1)"),
+// else "FILE: ".
+std::string whereMessageKeyIs(const std::string& file, const std::string& msg)
+{
+	if (msg.empty() || msg[0] != '[') return file + ": ";
+	const auto close = msg.find(']');
+	if (close == std::string::npos || close + 1 >= msg.size() || msg[close + 1] != ' ')
+		return file + ": ";
+	const auto key_begin = close + 2;
+	auto key_end = key_begin;
+	while (key_end < msg.size() && (std::isalnum(static_cast<unsigned char>(msg[key_end])) ||
+									msg[key_end] == '_' || msg[key_end] == '.'))
+		++key_end;
+	if (key_end == key_begin) return file + ": ";
+	return iniWhere(file, msg.substr(1, close - 1), msg.substr(key_begin, key_end - key_begin));
+}
+}  // namespace
+
 void rethrowNamingIniFile(const std::string& file)
 {
 	try
@@ -126,7 +166,9 @@ void rethrowNamingIniFile(const std::string& file)
 	catch (const std::exception& e)
 	{
 		const std::string msg = oneLineMessage(e.what());
-		const std::string named = msg.find(file) != std::string::npos ? msg : file + ": " + msg;
+		const std::string named = msg.find(file) != std::string::npos || startsWithAFile(msg)
+									  ? msg
+									  : whereMessageKeyIs(file, msg) + msg;
 		// Keep the kind: callers and tests tell invalid values from I/O errors.
 		if (dynamic_cast<const std::invalid_argument*>(&e)) throw std::invalid_argument(named);
 		throw std::runtime_error(named);

@@ -74,9 +74,10 @@ std::string oneLineMessage(const std::string& what);
 
 /** Call inside a catch block around the loading of the ini \a file:
  * rethrows the exception being handled as std::runtime_error (or
- * std::invalid_argument if it was one) naming the
- * file, and the line for an IniValueError; one line (MRPT's banner and call
- * stack dropped). */
+ * std::invalid_argument if it was one) naming the file, and the line for an
+ * IniValueError or a message that begins "[SECTION] KEY" (the options'
+ * validators); one line (MRPT's banner and call stack dropped). A message
+ * that already begins with another existing file's path is kept as is. */
 [[noreturn]] void rethrowNamingIniFile(const std::string& file);
 
 }  // namespace codemark
