@@ -7,7 +7,9 @@
 #include <mrpt/config/CConfigFile.h>
 #include <unistd.h>
 
+#include <exception>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 using namespace codemark;
@@ -60,6 +62,55 @@ TEST(BadFiles, IniNumbersNameFileLineAndKey)
 		});
 	EXPECT_NE(e.find(p + ":3: [LANDMARK] outer_size_m = '0.2x'"), std::string::npos) << e;
 	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+}
+
+// A validator's "[SECTION] KEY: why" gets the file and the key's line; a
+// message that already names another existing file is kept as it is; the
+// kind (invalid value or I/O) is kept.
+TEST(BadFiles, RethrowNamesTheLineOfAValidatorsKey)
+{
+	const auto p = writeTemp("opts.ini", "[a]\nk = 1\n\n[b]\n# c\nk = 2\nother = 3\n");
+	const auto other = writeTemp("other.ini", "[pose]\n");
+	const auto rethrown = [&](const std::exception_ptr& e)
+	{
+		try
+		{
+			try
+			{
+				std::rethrow_exception(e);
+			}
+			catch (const std::exception&)
+			{
+				rethrowNamingIniFile(p);
+			}
+		}
+		catch (const std::invalid_argument& x)
+		{
+			return "invalid: " + std::string(x.what());
+		}
+		catch (const std::runtime_error& x)
+		{
+			return "runtime: " + std::string(x.what());
+		}
+		return std::string();
+	};
+	const auto thrown = [](auto e) { return std::make_exception_ptr(e); };
+	EXPECT_EQ(
+		rethrown(thrown(std::invalid_argument("[b] k: must be > 0"))),
+		"invalid: " + p + ":6: [b] k: must be > 0");
+	EXPECT_EQ(
+		rethrown(thrown(std::invalid_argument("[B] Other = 'x' (expected y)"))),
+		"invalid: " + p + ":7: [B] Other = 'x' (expected y)");
+	// A key the file does not set (a default refused): the file alone.
+	EXPECT_EQ(
+		rethrown(thrown(std::runtime_error("[b] missing: must be > 0"))),
+		"runtime: " + p + ": [b] missing: must be > 0");
+	EXPECT_EQ(rethrown(thrown(std::runtime_error("no map"))), "runtime: " + p + ": no map");
+	// Another file's own error: kept.
+	EXPECT_EQ(
+		rethrown(thrown(std::runtime_error(other + ":1: bad"))), "runtime: " + other + ":1: bad");
+	EXPECT_EQ(
+		rethrown(thrown(std::runtime_error(other + ": no [x]"))), "runtime: " + other + ": no [x]");
 }
 
 TEST(BadFiles, IniNumbersAcceptGoodValuesAndTrailingComments)
