@@ -56,9 +56,6 @@ struct BenchConfig
  * section or key, missing required key, bad number, missing data file). */
 BenchConfig loadBenchConfig(const std::string& path);
 
-/** The four methods codemark-localize knows. */
-const std::vector<std::string>& knownMethods();
-
 /** Splits "a,b, c" into {"a","b","c"}; throws std::invalid_argument naming
  * \a what on an unknown method or an empty list. */
 std::vector<std::string> parseMethods(const std::string& list, const std::string& what);

@@ -1,4 +1,5 @@
 // codemark-bench: the benchmark ini (share/codemark/bench.ini documents it).
+#include <codemark/filters/localizer.h>
 #include <codemark/landmark/camera.h>
 #include <codemark/landmark/text.h>
 #include <codemark/pipeline/pipeline.h>
@@ -17,12 +18,6 @@
 namespace codemark::bench
 {
 namespace fs = std::filesystem;
-
-const std::vector<std::string>& knownMethods()
-{
-	static const std::vector<std::string> m{"ekf", "ekf-pose", "ekf-slam", "pf"};
-	return m;
-}
 
 namespace
 {
@@ -67,7 +62,7 @@ std::vector<std::string> parseMethods(const std::string& list, const std::string
 	{
 		m = trim(m);
 		if (m.empty()) continue;
-		const auto& k = knownMethods();
+		const auto& k = filters::localizationMethods();
 		if (std::find(k.begin(), k.end(), m) == k.end())
 			throw std::invalid_argument(
 				what + ": unknown method '" + m + "' (expected ekf, ekf-pose, ekf-slam or pf)");

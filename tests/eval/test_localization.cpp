@@ -248,6 +248,24 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 				<< e.what();
 		}
 	}
+	// An unknown method is the config file's error only when the file names it.
+	for (const bool from_file : {true, false})
+	{
+		req.config_file =
+			writeText("method.ini", from_file ? "[localize]\nmethod = ekff\n" : "[localize]\n");
+		req.method = from_file ? "" : "ekff";
+		try
+		{
+			runLocalization(req);
+			ADD_FAILURE() << "accepted method 'ekff'";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			const std::string m = e.what();
+			EXPECT_NE(m.find("unknown localization method 'ekff'"), std::string::npos) << m;
+			EXPECT_EQ(m.find(req.config_file) != std::string::npos, from_file) << m;
+		}
+	}
 }
 
 // SLAM's frame is its own start: the metrics align it to the truth (SE(2)

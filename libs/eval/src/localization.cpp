@@ -554,6 +554,16 @@ LocalizeSummary runLocalization(
 	else if (
 		req.map_file.empty() && !req.gt_map_file.empty() && !isMrptLandmarksFile(req.gt_map_file))
 		sizes = gt_map;
+	// A method named on the command line is not the config file's error.
+	try
+	{
+		requireLocalizationMethod(s.method);
+	}
+	catch (const std::exception&)
+	{
+		if (req.method.empty()) rethrowNamingIniFile(req.config_file);
+		throw;
+	}
 	ReadingOptions reading;
 	std::unique_ptr<Localizer> filter;
 	try

@@ -3,22 +3,38 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "factories.h"
 
 namespace codemark::filters
 {
+const std::vector<std::string>& localizationMethods()
+{
+	static const std::vector<std::string> m{"ekf", "ekf-pose", "ekf-slam", "pf"};
+	return m;
+}
+
+void requireLocalizationMethod(const std::string& method)
+{
+	const auto& m = localizationMethods();
+	if (std::find(m.begin(), m.end(), method) == m.end())
+		throw std::invalid_argument(
+			"unknown localization method '" + method +
+			"' (expected ekf, ekf-pose, ekf-slam or pf)");
+}
+
 std::unique_ptr<Localizer> makeLocalizer(
 	const std::string& method, const mrpt::config::CConfigFileBase& cfg, const LandmarkMap& map,
 	const std::optional<PoseEstimate>& initial)
 {
+	requireLocalizationMethod(method);
 	if (method == "ekf") return detail::makeEkf(cfg, map, initial);
 	if (method == "ekf-pose") return detail::makeEkfPose(cfg, map, initial);
 	if (method == "ekf-slam") return detail::makeEkfSlam(cfg, map, initial);
 	if (method == "pf") return detail::makeParticleFilter(cfg, map, initial);
-	throw std::invalid_argument(
-		"unknown localization method '" + method + "' (expected ekf, ekf-pose, ekf-slam or pf)");
+	throw std::logic_error("makeLocalizer: no factory for method '" + method + "'");
 }
 
 std::optional<PoseEstimate> initialPose(const mrpt::config::CConfigFileBase& cfg)

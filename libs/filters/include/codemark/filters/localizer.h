@@ -132,6 +132,14 @@ class Localizer
 	virtual std::vector<MappedLandmark> landmarks() const { return {}; }
 };
 
+/** The names of the localization methods: "ekf", "ekf-pose", "ekf-slam",
+ * "pf". */
+const std::vector<std::string>& localizationMethods();
+
+/** Throws std::invalid_argument "unknown localization method 'M' (expected
+ * ...)" unless \a method is one of localizationMethods(). */
+void requireLocalizationMethod(const std::string& method);
+
 /** Creates the filter \a method ("ekf", "ekf-pose", "ekf-slam", "pf") from
  * the ini \a cfg (share/codemark/config/<method>.ini) and the landmark map
  * (required for localization, optional prior for SLAM). \a initial, when
