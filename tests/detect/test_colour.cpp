@@ -63,7 +63,20 @@ TEST(Colour, ReportReadsTheColoursOfAKnownPrint)
 			EXPECT_NEAR(c.margin_hue_max_deg, opt.segmentation.hue_max_deg - c.fill.hue_deg, 1e-12);
 			EXPECT_NEAR(
 				c.margin_intensity, c.fill.intensity - opt.segmentation.min_intensity, 1e-12);
-			EXPECT_NEAR(c.margin_black_ratio, opt.code.max_black_ratio - 35 / green_bgr[1], 0.01);
+			// The ratio compares the frame's ink: the level read less the
+			// share of fill and sheet a 1.5 px blur would spread over it. At
+			// 1 m the frame spans 15 px and has no share; at 3 m (5 px) this
+			// sharp render's ink reads darker than its level.
+			const double as_read = opt.code.max_black_ratio - 35 / green_bgr[1];
+			if (dist < 2)
+			{
+				EXPECT_NEAR(c.margin_black_ratio, as_read, 0.01);
+			}
+			else
+			{
+				EXPECT_GT(c.margin_black_ratio, as_read + 0.01);
+				EXPECT_LT(c.margin_black_ratio, as_read + 0.2);
+			}
 			EXPECT_NEAR(c.margin_contrast, green_bgr[1] - 35 - opt.code.min_contrast, 1.0);
 			// The JSON object carries every field.
 			const std::string json = colourReportJson(c);

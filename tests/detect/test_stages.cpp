@@ -41,6 +41,32 @@ cv::Mat craftedLandmark(int id, int o = 40, double blur = 0.8, int size = 180)
 	return img;
 }
 
+/** A landmark (ID 0) whose reference square spans \a side px, printed with
+ * the fill, frame and sheet levels given (BGR), under a Gaussian blur of
+ * \a blur px: drawn 8 times finer, blurred there and averaged over each
+ * pixel (so the total blur is a little wider than \a blur). The reference
+ * square's corners lie at o - 0.5 and o + side - 0.5. */
+cv::Mat printedLandmark(
+	int side, const cv::Scalar& fill, const cv::Scalar& frame, const cv::Scalar& sheet, double blur,
+	int o = 30, int size = 100)
+{
+	const int k = 8;
+	const double inner = side * k, at = o * k;
+	const double f = inner * 20 / 160, cell = inner * 30 / 160, board = at + inner / 2 - 1.5 * cell;
+	cv::Mat fine(size * k, size * k, CV_8UC3, sheet);
+	const auto box = [&](double x, double y, double w, const cv::Scalar& c) {
+		cv::rectangle(
+			fine, cv::Rect(cvRound(x), cvRound(y), cvRound(w), cvRound(w)), c, cv::FILLED);
+	};
+	box(at - f, at - f, inner + 2 * f, frame);
+	box(at, at, inner, fill);
+	box(board + cell, board + cell, cell, frame);  // the centre cell: ID 0
+	if (blur > 0) cv::GaussianBlur(fine, fine, cv::Size(0, 0), blur * k);
+	cv::Mat img;
+	cv::resize(fine, img, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+	return img;
+}
+
 std::array<Eigen::Vector2d, 4> craftedCorners(int o = 40)
 {
 	const double a = o + 9.5, b = o + 89.5;
@@ -193,6 +219,79 @@ TEST(Components, FrameEvidence)
 			findCandidates(segmentColour(img, SegmentationParams()), 2, img, ComponentParams())
 				.empty());
 	}
+}
+
+TEST(Frame, TheInkOfABlurredBar)
+{
+	// A black bar between a fill and a sheet, blurred (sigma 1.5 px) and
+	// integrated over pixels: its middle reads lighter than its ink, more the
+	// thinner it is; unblurredFrameLevel() gives the ink back.
+	const double ink = 40, fill = 160, sheet = 220, blur = 1.5;
+	for (const int width : {3, 4, 6, 10})
+	{
+		const int k = 16, w = 60;
+		cv::Mat fine(1, w * k, CV_64F, cv::Scalar(fill));
+		fine.colRange(20 * k, (20 + width) * k).setTo(ink);
+		fine.colRange((20 + width) * k, w * k).setTo(sheet);
+		// The pixel's own width adds a box blur of variance 1/12.
+		cv::GaussianBlur(
+			fine, fine, cv::Size(0, 0), std::sqrt(blur * blur - 1.0 / 12) * k, 0,
+			cv::BORDER_REPLICATE);
+		cv::Mat px;
+		cv::resize(fine, px, cv::Size(w, 1), 0, 0, cv::INTER_AREA);
+		// Pixel 20 + x covers [20 + x, 21 + x): the bar's middle is at
+		// 20 + width / 2, i.e. at pixel index 19.5 + width / 2.
+		const double mid = 19.5 + 0.5 * width;
+		const auto at = [&](double x)
+		{
+			const int i = static_cast<int>(std::floor(x));
+			const double t = x - i;
+			return (1 - t) * px.at<double>(0, i) + t * px.at<double>(0, i + 1);
+		};
+		double band = 0;  // the code stage's samples: the middle half
+		for (int i = -2; i <= 2; ++i) band += at(mid + 0.25 * width * i / 2.0) / 5;
+		const double middle = at(mid);
+		const double middle_ink =
+			unblurredFrameLevel(middle, fill, sheet, frameNeighbourShare(width, blur));
+		const double band_ink =
+			unblurredFrameLevel(band, fill, sheet, frameNeighbourShare(width, blur, 0.25));
+		// Within a few levels (the bilinear reads between pixels blur a
+		// little more).
+		EXPECT_NEAR(middle_ink, ink, 5.0) << width;
+		EXPECT_NEAR(band_ink, ink, 5.0) << width;
+		if (width <= 4)
+		{
+			EXPECT_GT(band - ink, 25) << width;	 // what the correction undoes
+		}
+	}
+	// Wide frames need none; the thinnest are corrected by at most a quarter
+	// of each neighbour.
+	EXPECT_LT(frameNeighbourShare(20, 1.5), 1e-9);
+	EXPECT_EQ(frameNeighbourShare(1, 1.5), 0.25);
+	EXPECT_EQ(frameNeighbourShare(4, 0), 0);
+}
+
+TEST(Components, FrameEvidenceOfAThinFrame)
+{
+	// A dim laser print (fill G 107, toner G 70, sheet G 140) at 32 px: its
+	// 4 px frame reads about 0.75 of the fill under a 1.5 px blur, its ink
+	// 0.65. The frame check compares the ink: found; a grey frame (G 95) is
+	// still refused.
+	const cv::Scalar fill(40, 107, 50), toner(70, 70, 70), grey(95, 95, 95), sheet(140, 140, 140);
+	const cv::Mat dim = printedLandmark(32, fill, toner, sheet, 1.5);
+	const cv::Mat mask = segmentColour(dim, SegmentationParams());
+	ComponentParams p;
+	EXPECT_EQ(findCandidates(mask, 2, dim, p).size(), 1u);
+	ComponentParams as_read = p;
+	as_read.frame_blur_px = 0;
+	EXPECT_TRUE(findCandidates(mask, 2, dim, as_read).empty());
+	const cv::Mat greyed = printedLandmark(32, fill, grey, sheet, 1.5);
+	EXPECT_TRUE(findCandidates(segmentColour(greyed, SegmentationParams()), 2, greyed, p).empty());
+	// At 80 px the frame (10 px) reads its ink with or without the model.
+	const cv::Mat near = printedLandmark(80, fill, toner, sheet, 1.5, 30, 160);
+	const cv::Mat near_mask = segmentColour(near, SegmentationParams());
+	EXPECT_EQ(findCandidates(near_mask, 2, near, p).size(), 1u);
+	EXPECT_EQ(findCandidates(near_mask, 2, near, as_read).size(), 1u);
 }
 
 TEST(Components, CentreEvidence)
@@ -930,6 +1029,27 @@ TEST(Code, RejectsGreenCentreOtherFillAndMissingFrame)
 	for (auto& c : qc.corners_raw) c.x() -= 45;
 	qc.corners_ideal = qc.corners_raw;
 	EXPECT_FALSE(readCode(cut, qc, CameraModel(), g, CodeParams()));
+}
+
+TEST(Code, TheFrameCheckComparesTheInk)
+{
+	// The dim laser print of FrameEvidenceOfAThinFrame, its corners known:
+	// read with the blur's correction, refused without; a grey frame is
+	// refused either way.
+	const LandmarkGeometry g;
+	const cv::Scalar fill(40, 107, 50), toner(70, 70, 70), grey(95, 95, 95), sheet(140, 140, 140);
+	RefinedQuad q;
+	const double a = 30 - 0.5, b = 30 + 32 - 0.5;
+	q.corners_raw = q.corners_ideal = {
+		Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b), Eigen::Vector2d(a, b)};
+	const cv::Mat dim = printedLandmark(32, fill, toner, sheet, 1.5);
+	const auto r = readCode(dim, q, CameraModel(), g, CodeParams());
+	ASSERT_TRUE(r);
+	EXPECT_EQ(r->id, 0);
+	EXPECT_GT(r->black_g, 0.7 * r->green_g);  // as read: lighter than the ratio allows
+	EXPECT_FALSE(readCode(dim, q, CameraModel(), g, CodeParams(), 0));
+	const cv::Mat greyed = printedLandmark(32, fill, grey, sheet, 1.5);
+	EXPECT_FALSE(readCode(greyed, q, CameraModel(), g, CodeParams()));
 }
 
 TEST(Code, AmbiguousCellIsRejected)

@@ -42,6 +42,46 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v)
 	return (1 - fy) * top + fy * bot;
 }
 
+double frameNeighbourShare(double width_px, double blur_px, double half_band)
+{
+	if (!(blur_px > 0) || !(width_px > 0)) return 0;
+	const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+	double share = 0;
+	for (int i = -2; i <= 2; ++i) share += phi(-(0.5 + half_band * i / 2.0) * width_px / blur_px);
+	return std::min(0.25, share / 5);
+}
+
+FrameSurround frameSurround(
+	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo, int side, double blur_px)
+{
+	const double h = geo.innerHalf(), outer = geo.outerHalf() / h;
+	const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
+	FrameSurround out;
+	out.width_px = (map(nx * outer, ny * outer) - map(nx, ny)).norm();
+	// The sheet where the blur takes it from: two blur widths beyond the
+	// frame, or the quiet margin's middle if that is farther (whatever lies
+	// there is what the blur brings in).
+	const double rs =
+		outer +
+		std::max(0.5 * geo.margin_m / h, 2 * blur_px * (outer - 1) / std::max(out.width_px, 1.0));
+	double sum = 0;
+	int reads = 0;
+	for (const double t : {-0.5, 0.0, 0.5})
+	{
+		const Eigen::Vector2d px = map(rs * (nx + ny * t), rs * (ny - nx * t));
+		if (const auto g = sampleG(bgr, px.x(), px.y()))
+		{
+			sum += *g;
+			++reads;
+		}
+	}
+	// No sheet in the image: the level as read.
+	if (reads == 0) return out;
+	out.sheet_g = sum / reads;
+	out.share = frameNeighbourShare(out.width_px, blur_px, 0.25);
+	return out;
+}
+
 namespace
 {
 
@@ -65,7 +105,7 @@ std::optional<double> patchMean(
 
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& cam, const LandmarkGeometry& geo,
-	const CodeParams& p)
+	const CodeParams& p, double frame_blur_px)
 {
 	const FaceMap map{faceToImage(q.corners_ideal), cam, cam.hasDistortion()};
 	const double h = geo.innerHalf();
@@ -89,8 +129,9 @@ std::optional<CodeReading> readCode(
 	const double board = 1.5 * geo.cell_size_m / h;
 	const double rg = 0.5 * (board + 1);
 	const double band_b = 0.25 * (outer - 1), band_g = 0.25 * (1 - board);
-	std::array<double, 4> black{}, green{};
-	const double dirs[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+	// The frame's ink, without the fill and the sheet that blur spreads over
+	// it (frameNeighbourShare()): the level the ratio checks compare.
+	std::array<double, 4> black{}, green{}, ink{};
 	for (int side = 0; side < 4; ++side)
 	{
 		double sb = 0, sg = 0;
@@ -98,7 +139,7 @@ std::optional<CodeReading> readCode(
 		for (int k = 0; k < n; ++k)
 		{
 			const double t = -0.5 + 0.5 * k;  // along the side, within its middle
-			const double nx = dirs[side][0], ny = dirs[side][1];
+			const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
 			// Along-side direction is (ny, -nx).
 			const double ax = ny * t, ay = -nx * t;
 			const double rx_b = nx != 0 ? band_b : 0.08, ry_b = ny != 0 ? band_b : 0.08;
@@ -111,6 +152,7 @@ std::optional<CodeReading> readCode(
 		}
 		black[side] = sb / n;
 		green[side] = sg / n;
+		ink[side] = frameSurround(bgr, map, geo, side, frame_blur_px).ink(black[side], green[side]);
 	}
 	CodeReading r;
 	r.green_g = 0.25 * (green[0] + green[1] + green[2] + green[3]);
@@ -121,9 +163,11 @@ std::optional<CodeReading> readCode(
 	r.black_g = 0.5 * (sorted[0] + sorted[1]);
 	const double contrast = r.green_g - r.black_g;
 	if (contrast < p.min_contrast) return std::nullopt;
-	if (r.black_g > p.max_black_ratio * r.green_g) return std::nullopt;
+	std::array<double, 4> ink_sorted = ink;
+	std::sort(ink_sorted.begin(), ink_sorted.end());
+	if (0.5 * (ink_sorted[0] + ink_sorted[1]) > p.max_black_ratio * r.green_g) return std::nullopt;
 	for (int side = 0; side < 4; ++side)
-		if (black[side] > p.max_side_black_ratio * green[side] ||
+		if (ink[side] > p.max_side_black_ratio * green[side] ||
 			green[side] < r.black_g + 0.5 * contrast)
 			return std::nullopt;
 	const double thr = 0.5 * (r.green_g + r.black_g);

@@ -99,12 +99,20 @@ ColourReport colourReport(
 	out.margin_saturation = out.fill.saturation - s.min_saturation;
 	out.margin_hue_min_deg = out.fill.hue_deg - s.hue_min_deg;
 	out.margin_hue_max_deg = s.hue_max_deg - out.fill.hue_deg;
-	// The frame's G as the code stage reads it: its two darkest sides.
-	std::array<double, 4> sides{};
-	for (int k = 0; k < 4; ++k) sides[k] = side_n[k] > 0 ? side_g[k] / side_n[k] : 255;
+	// The frame's G as the code stage reads it: its two darkest sides, and
+	// their ink (the blur's share of the fill and the sheet removed) for the
+	// ratio.
+	std::array<double, 4> sides{}, inks{};
+	for (int k = 0; k < 4; ++k)
+	{
+		sides[k] = side_n[k] > 0 ? side_g[k] / side_n[k] : 255;
+		inks[k] = frameSurround(bgr, map, geometry, k, opt.components.frame_blur_px)
+					  .ink(sides[k], out.fill.g);
+	}
 	std::sort(sides.begin(), sides.end());
-	const double frame_g = 0.5 * (sides[0] + sides[1]);
-	out.margin_black_ratio = out.fill.g > 0 ? opt.code.max_black_ratio - frame_g / out.fill.g : -1;
+	std::sort(inks.begin(), inks.end());
+	const double frame_g = 0.5 * (sides[0] + sides[1]), ink_g = 0.5 * (inks[0] + inks[1]);
+	out.margin_black_ratio = out.fill.g > 0 ? opt.code.max_black_ratio - ink_g / out.fill.g : -1;
 	out.margin_contrast = out.fill.g - frame_g - opt.code.min_contrast;
 	return out;
 }

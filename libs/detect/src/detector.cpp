@@ -57,19 +57,19 @@ DetectionResult detectWithModels(
 	tm.segmentation_us = microsSince(t);
 
 	// 3. N4-connected components, cardinality and compactness: ROIs.
-	cv::Mat labels;
-	const auto candidates = findCandidates(
-		mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
-		&res.counts.components, geometry.cell_size_m / geometry.inner_size_m);
-	res.counts.rois = static_cast<int>(candidates.size());
-	tm.components_us = microsSince(t);
-
 	// The landmark's proportions over the reference square's side: the black
 	// frame's width, and the green band's between it and the code board.
 	const double frame_ratio =
 		(geometry.outerHalf() - geometry.innerHalf()) / geometry.inner_size_m;
 	const double fill_ratio =
 		(geometry.inner_size_m - 3 * geometry.cell_size_m) / (2 * geometry.inner_size_m);
+	cv::Mat labels;
+	const auto candidates = findCandidates(
+		mask, opt.segmentation.step_px, bgr, opt.components, debug ? &labels : nullptr,
+		&res.counts.components, geometry.cell_size_m / geometry.inner_size_m, frame_ratio);
+	res.counts.rois = static_cast<int>(candidates.size());
+	tm.components_us = microsSince(t);
+
 	for (const Candidate& cand : candidates)
 	{
 		// 4. Gradients of G in the ROI: edgels with polarity, edgel domains.
@@ -103,7 +103,8 @@ DetectionResult detectWithModels(
 		++res.counts.fitted;
 
 		// 8. Code cells through the corners' homography.
-		const auto code = readCode(bgr, *refined, camera, geometry, opt.code);
+		const auto code =
+			readCode(bgr, *refined, camera, geometry, opt.code, opt.components.frame_blur_px);
 		tm.code_us += microsSince(t);
 		if (debug) dbg.quads.push_back(*refined);
 		if (!code) continue;

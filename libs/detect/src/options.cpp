@@ -91,6 +91,7 @@ void forEachField(Options& o, F&& f)
 	f("components.roi_grow_px", o.components.roi_grow_px);
 	f("components.max_frame_ratio", o.components.max_frame_ratio);
 	f("components.max_side_frame_ratio", o.components.max_side_frame_ratio);
+	f("components.frame_blur_px", o.components.frame_blur_px);
 	f("components.min_centre_cell_px", o.components.min_centre_cell_px);
 	f("components.max_candidates", o.components.max_candidates);
 	f("edgels.min_gradient", o.edgels.min_gradient);
@@ -147,6 +148,8 @@ void DetectorOptions::validate() const
 		c.max_frame_ratio > 0 && c.max_side_frame_ratio >= c.max_frame_ratio,
 		"components.max_frame_ratio/max_side_frame_ratio",
 		"> 0 and max_side_frame_ratio >= max_frame_ratio");
+	require(
+		c.frame_blur_px >= 0 && c.frame_blur_px <= 10, "components.frame_blur_px", "in [0, 10]");
 	require(c.max_candidates >= 1, "components.max_candidates", ">= 1");
 	require(c.min_centre_cell_px >= 0, "components.min_centre_cell_px", ">= 0");
 	require(

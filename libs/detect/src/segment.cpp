@@ -166,21 +166,32 @@ struct Moments
 	int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;  // inclusive bbox
 };
 
-/** Darkest G along a ray of \a n pixels from (x, y) in direction (dx, dy);
- * -1 when the ray leaves the image at once. */
-int darkestAlong(const cv::Mat& bgr, int x, int y, int dx, int dy, int n)
+/** Along a ray of \a n pixels from (x, y) in direction (dx, dy): the darkest
+ * G (the frame) and the brightest G beyond it (the sheet, or whatever lies
+ * next to the frame); dark < 0 when the ray leaves the image at once. */
+struct RayLevels
 {
-	int best = -1;
+	int dark = -1, beyond = -1;
+};
+RayLevels darkestAlong(const cv::Mat& bgr, int x, int y, int dx, int dy, int n)
+{
+	RayLevels r;
 	for (int i = 0; i < n; ++i, x += dx, y += dy)
 	{
 		if (x < 0 || y < 0 || x >= bgr.cols || y >= bgr.rows) break;
 		const int g = bgr.ptr<uint8_t>(y)[3 * x + 1];
-		if (best < 0 || g < best) best = g;
+		if (r.dark < 0 || g < r.dark)
+		{
+			r.dark = g;
+			r.beyond = g;
+		}
+		r.beyond = std::max(r.beyond, g);
 	}
-	return best;
+	return r;
 }
 
-bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const ComponentParams& p)
+bool frameEvidence(
+	const cv::Mat& bgr, const Candidate& c, int step, double frame_rel, const ComponentParams& p)
 {
 	if (p.max_frame_ratio >= 1) return true;
 	std::array<double, 4> side{};
@@ -189,30 +200,36 @@ bool frameEvidence(const cv::Mat& bgr, const Candidate& c, int step, const Compo
 	// Rays start a grid step inside the box (its sides are a step coarse) and
 	// reach a frame width (1/8 of the side) plus margins beyond it.
 	const int nx = step + 3 + c.bbox.width / 6, ny = step + 3 + c.bbox.height / 6;
+	// The frame's width across the top and bottom sides, and across the left
+	// and right ones.
+	const double share_tb = frameNeighbourShare(frame_rel * c.bbox.height, p.frame_blur_px),
+				 share_lr = frameNeighbourShare(frame_rel * c.bbox.width, p.frame_blur_px);
 	for (int k = 0; k < 4; ++k)
 	{
-		std::array<int, 3> m{};
+		std::array<double, 3> m{};
 		for (int j = 0; j < 3; ++j)
 		{
 			const double t = 0.25 * (j + 1);
 			const int xm = x0 + static_cast<int>(t * (x1 - x0)),
 					  ym = y0 + static_cast<int>(t * (y1 - y0));
+			RayLevels r;
 			switch (k)
 			{
 				case 0:
-					m[j] = darkestAlong(bgr, xm, y0 + step, 0, -1, ny);
+					r = darkestAlong(bgr, xm, y0 + step, 0, -1, ny);
 					break;	// top
 				case 1:
-					m[j] = darkestAlong(bgr, x1 - step, ym, 1, 0, nx);
+					r = darkestAlong(bgr, x1 - step, ym, 1, 0, nx);
 					break;	// right
 				case 2:
-					m[j] = darkestAlong(bgr, xm, y1 - step, 0, 1, ny);
+					r = darkestAlong(bgr, xm, y1 - step, 0, 1, ny);
 					break;	// bottom
 				default:
-					m[j] = darkestAlong(bgr, x0 + step, ym, -1, 0, nx);
+					r = darkestAlong(bgr, x0 + step, ym, -1, 0, nx);
 					break;	// left
 			}
-			if (m[j] < 0) return false;
+			if (r.dark < 0) return false;
+			m[j] = unblurredFrameLevel(r.dark, c.fill_g, r.beyond, k % 2 ? share_lr : share_tb);
 		}
 		std::sort(m.begin(), m.end());
 		side[k] = m[1];
@@ -255,7 +272,7 @@ inline double sumSquares(double k) { return k * (k + 1) * (2 * k + 1) / 6; }  //
 
 std::vector<Candidate> findCandidates(
 	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
-	cv::Mat* labels_out, int* num_components, double centre_cell_rel)
+	cv::Mat* labels_out, int* num_components, double centre_cell_rel, double frame_rel)
 {
 	// N4-connected components by runs and union-find, hand-written because
 	// the moments up to second order then come per run in closed form, and a
@@ -390,9 +407,10 @@ std::vector<Candidate> findCandidates(
 		out.erase(
 			std::remove_if(
 				out.begin(), out.end(),
-				[&](const Candidate& c) {
+				[&](const Candidate& c)
+				{
 					return !centreEvidence(mask, c, step, centre_cell_rel, p) ||
-						   !frameEvidence(bgr, c, step, p);
+						   !frameEvidence(bgr, c, step, frame_rel, p);
 				}),
 			out.end());
 	}

@@ -64,7 +64,25 @@ struct Candidate
  * evidence test, ComponentParams::min_centre_cell_px). */
 std::vector<Candidate> findCandidates(
 	const cv::Mat& mask, int step, const cv::Mat& bgr, const ComponentParams& p,
-	cv::Mat* labels = nullptr, int* num_components = nullptr, double centre_cell_rel = 30.0 / 160);
+	cv::Mat* labels = nullptr, int* num_components = nullptr, double centre_cell_rel = 30.0 / 160,
+	double frame_rel = 20.0 / 160);
+
+/** The black frame's darkness, whatever its width in pixels. A frame of
+ * width \a width_px between two brighter neighbours reads lighter than its
+ * ink: a blur of \a blur_px (Gaussian sigma) spreads each neighbour over it.
+ * At an offset x from the frame's middle, each neighbour contributes the
+ * share Phi(-(w/2 + x) / sigma) and Phi(-(w/2 - x) / sigma) of its level.
+ * frameNeighbourShare() is that share averaged over the offsets
+ * \a half_band x w x {-1, -1/2, 0, 1/2, 1} (the frame's samples; 0: its
+ * middle alone), capped at 1/4 (a frame under about 1.3 sigma: the model
+ * then corrects less than the blur lifts, never more).
+ * unblurredFrameLevel() undoes it: the ink's level from the level
+ * \a measured between neighbours \a inner and \a outer. */
+double frameNeighbourShare(double width_px, double blur_px, double half_band = 0);
+inline double unblurredFrameLevel(double measured, double inner, double outer, double share)
+{
+	return (measured - share * (inner + outer)) / (1 - 2 * share);
+}
 
 // ------------------------------------------------------------------ stage 4
 /** Polarity of an edgel, named after the inner frame edge that has it: the
@@ -551,12 +569,34 @@ struct FaceMap
 /** Mean G at a raw pixel position (bilinear); nullopt outside the image. */
 std::optional<double> sampleG(const cv::Mat& bgr, double u, double v);
 
+/** Outward normals of the reference square's sides top, right, bottom,
+ * left in normalised face coordinates. */
+inline constexpr double kSideNormals[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+
+/** What surrounds one side of the frame (\a side: top, right, bottom,
+ * left): its width in pixels across the side's middle, the sheet's G
+ * beyond it and the share of each neighbour that a blur of \a blur_px
+ * spreads over the frame's middle half (frameNeighbourShare(); 0 when the
+ * sheet lies outside the image). */
+struct FrameSurround
+{
+	double width_px = 0, sheet_g = 0, share = 0;
+	/** The frame's ink from the level \a frame_g read over its middle half
+	 * next to the fill's \a fill_g. */
+	double ink(double frame_g, double fill_g) const
+	{
+		return unblurredFrameLevel(frame_g, fill_g, sheet_g, share);
+	}
+};
+FrameSurround frameSurround(
+	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo, int side, double blur_px);
+
 /** Checks the frame (inside the image, black on every side, green ring) and
  * reads the 3x3 cells; nullopt when any check fails, the centre cell is
  * green or a cell is ambiguous. */
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
-	const CodeParams& p);
+	const CodeParams& p, double frame_blur_px = 1.5);
 
 // ---------------------------------------------------------------- detector
 /** detect() with the sub-pixel stage's models switched by \a models (the

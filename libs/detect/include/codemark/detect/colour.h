@@ -39,7 +39,9 @@ struct ColourReport
 	double margin_saturation = 0;  //!< fill S - segmentation.min_saturation [-]
 	double margin_hue_min_deg = 0;	//!< fill hue - segmentation.hue_min_deg [deg]
 	double margin_hue_max_deg = 0;	//!< segmentation.hue_max_deg - fill hue [deg]
-	/** code.max_black_ratio - frame G / fill G [-]. */
+	/** code.max_black_ratio - frame ink / fill G [-] (the ink: the two darkest
+	 * sides with the blur's share of fill and sheet removed, as the check
+	 * compares it). */
 	double margin_black_ratio = 0;
 	/** code.min_contrast subtracted from fill G - frame G [grey levels]. */
 	double margin_contrast = 0;

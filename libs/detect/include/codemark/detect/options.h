@@ -72,6 +72,16 @@ struct ComponentParams
 	 * 0.5-0.55. 1 disables. */
 	double max_frame_ratio = 0.7;
 	double max_side_frame_ratio = 0.9;
+	/** Both frame checks (this one and CodeParams::max_black_ratio) compare
+	 * the frame's ink, not its blurred image: a frame a few pixels wide
+	 * reads lighter than its ink because the blur spreads the fill and the
+	 * sheet next to it over it. The level read is corrected for the largest
+	 * blur the detector is built for (Gaussian sigma, the target ranges'
+	 * 1.5 px) at the frame's width in pixels: a frame of 4 px (a 32 px
+	 * square) has about a tenth of each neighbour's level added, one of 10
+	 * px none. A sharper image is corrected more than it was lifted, which
+	 * the checks' margins absorb [px]. 0 reads the level as it is. */
+	double frame_blur_px = 1.5;
 	/** Centre evidence: the code board's centre cell is always black, so a
 	 * landmark's fill component has a hole at its centre. When the centre
 	 * cell is surely large enough to open that hole in the mask (its
@@ -194,8 +204,10 @@ struct CodeParams
 	double patch_fraction = 0.4;
 	/** Smallest contrast G(green) - G(black) [grey levels]. */
 	double min_contrast = 20;
-	/** The frame's G (mean of its two darkest sides) must stay below this
-	 * fraction of the fill's: a black frame, not a grey or coloured one.
+	/** The frame's G (mean of its two darkest sides; each side's ink, the
+	 * blur's share of the fill and sheet removed as
+	 * ComponentParams::frame_blur_px says) must stay below this fraction of
+	 * the fill's: a black frame, not a grey or coloured one.
 	 * Encoded grey levels: printed black against a printed green is about
 	 * 0.1-0.2 in linear light and up to 0.55 through a camera's transfer
 	 * curve (ComponentParams::max_frame_ratio). */
