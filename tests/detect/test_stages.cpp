@@ -414,6 +414,47 @@ TEST(Quadrangle, GreenSquareOnBlackGivesAQuadrangle)
 	EXPECT_TRUE(coarseQuad(img));
 }
 
+TEST(Segments, AShortGhostBesideTheInnerEdgeDoesNotReplaceIt)
+{
+	// The fill's box spans [20, 52) both ways. Each side has its inner edge
+	// spanning the side; below, a piece of ghost edge 16 px long lies 2 px
+	// nearer the box's side than the inner edge (as a sharpened or dim side
+	// leaves one): the side is the inner edge, whose ends reach the corners.
+	Candidate c;
+	c.bbox = cv::Rect(20, 20, 32, 32);
+	c.centroid = Eigen::Vector2d(35.5, 35.5);
+	const auto domain = [](Polarity pol, Eigen::Vector2d a, Eigen::Vector2d b)
+	{
+		EdgelDomain d;
+		d.polarity = pol;
+		d.end0 = a;
+		d.end1 = b;
+		d.mean = 0.5 * (a + b);
+		d.dir = (b - a).normalized();
+		d.length_px = (b - a).norm();
+		d.count = static_cast<int>(d.length_px) + 1;
+		return d;
+	};
+	std::vector<EdgelDomain> domains{
+		domain(Polarity::Top, {21, 20.5}, {50, 20.5}),
+		domain(Polarity::Right, {50.5, 21}, {50.5, 50}),
+		domain(Polarity::Bottom, {21, 49.5}, {50, 49.5}),
+		domain(Polarity::Left, {20.5, 21}, {20.5, 50}),
+		domain(Polarity::Bottom, {35, 51.5}, {50, 51.5})};
+	const auto s = selectSegments(domains, c, cv::Mat(), 2, SegmentParams());
+	ASSERT_TRUE(s);
+	EXPECT_NEAR((*s)[2].mean.y(), 49.5, 1e-9);
+	EXPECT_NEAR((*s)[2].length_px, 29, 1e-9);
+	EXPECT_TRUE(linkQuadrangle(*s, QuadParams()));
+	// A long edge a fifth of the side inside (a code cell's row) is not the
+	// side either: the nearest qualified domain is.
+	domains.pop_back();
+	domains.push_back(domain(Polarity::Bottom, {21, 43}, {50, 43}));
+	const auto t = selectSegments(domains, c, cv::Mat(), 2, SegmentParams());
+	ASSERT_TRUE(t);
+	EXPECT_NEAR((*t)[2].mean.y(), 49.5, 1e-9);
+}
+
 TEST(Quadrangle, RejectsSegmentsFarFromTheirCorners)
 {
 	SideSegments s;

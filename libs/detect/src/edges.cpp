@@ -231,8 +231,7 @@ std::optional<SideSegments> selectSegments(
 		const double bbox_side =
 			low_side ? (axis == 0 ? c.bbox.x : c.bbox.y) - 0.5
 					 : (axis == 0 ? c.bbox.x + c.bbox.width : c.bbox.y + c.bbox.height) - 0.5;
-		const EdgelDomain* best = nullptr;
-		double best_dist = std::numeric_limits<double>::max();
+		std::vector<std::pair<const EdgelDomain*, double>> qualified;  // with its distance
 		for (const auto& d : domains)
 		{
 			if (d.polarity != pol) continue;
@@ -248,14 +247,19 @@ std::optional<SideSegments> selectSegments(
 			const double across = vertical_side ? c.bbox.width : c.bbox.height;
 			if (!mask.empty() && !fillInside(d, inward, fill_band_rel * across)) continue;
 			if (!fillInImage(d, inward)) continue;
-			const double dist = std::abs(d.mean(axis) - bbox_side);
-			if (dist < best_dist)
-			{
-				best_dist = dist;
-				best = &d;
-			}
+			qualified.emplace_back(&d, std::abs(d.mean(axis) - bbox_side));
 		}
-		if (!best) return std::nullopt;
+		if (qualified.empty()) return std::nullopt;
+		// The nearest, unless a longer one lies within a tenth of the side
+		// behind it (half the way to the code cells' edges): a dim or
+		// sharpened side can leave a short piece of ghost edge a pixel or
+		// two beside the inner edge, whose domain spans the whole side.
+		double nearest = std::numeric_limits<double>::max();
+		for (const auto& q : qualified) nearest = std::min(nearest, q.second);
+		const double window = nearest + std::max(1.0, 0.1 * extent);
+		const EdgelDomain* best = nullptr;
+		for (const auto& [d, dist] : qualified)
+			if (dist <= window && (!best || d->length_px > best->length_px)) best = d;
 		out[k] = *best;
 	}
 	return out;
