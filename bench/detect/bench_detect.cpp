@@ -27,6 +27,7 @@ extern "C"
 }
 
 #include <algorithm>
+#include <filesystem>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -1103,13 +1104,13 @@ int main(int argc, char** argv)
 			"", "revision", "source revision to print in the report", false, "", "TEXT", cmd);
 		TCLAP::ValueArg<std::string> dump(
 			"", "dump-misses",
-			"write codemark's missed sweep frames (PNG + true corners) into this existing "
-			"directory",
+			"write codemark's missed sweep frames (PNG + true corners) into this folder "
+			"(created when missing)",
 			false, "", "DIR", cmd);
 		TCLAP::ValueArg<std::string> dump_clutter(
 			"", "dump-clutter",
 			"write the background-only frames in which codemark examines ROIs (PNG) into this "
-			"existing directory",
+			"folder (created when missing)",
 			false, "", "DIR", cmd);
 		TCLAP::ValueArg<std::string> preset(
 			"", "preset",
@@ -1137,6 +1138,8 @@ int main(int argc, char** argv)
 		cfg.revision = revision.getValue();
 		cfg.dump_dir = dump.getValue();
 		cfg.clutter_dir = dump_clutter.getValue();
+		for (const std::string& dir : {cfg.dump_dir, cfg.clutter_dir})
+			if (!dir.empty()) std::filesystem::create_directories(dir);
 		if (profile_repeat.getValue() < 0)
 			throw std::invalid_argument("--profile-repeat must be >= 0");
 		cfg.profile_repeat = profile_repeat.getValue();
