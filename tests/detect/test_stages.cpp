@@ -455,6 +455,45 @@ TEST(Segments, AShortGhostBesideTheInnerEdgeDoesNotReplaceIt)
 	EXPECT_NEAR((*t)[2].mean.y(), 49.5, 1e-9);
 }
 
+TEST(Segments, AGreenTintedWallIsNotTheFill)
+{
+	// A dim print (fill G 107) on a grey wall that the white balance tints
+	// green (G 60, R = B = 50) next to it, darker beyond. The codec smeared
+	// the green over the thin frame, so the fill's box reaches past the
+	// frame and the tinted wall's edge is the right-side domain nearest it;
+	// inside that edge the image is green-ish but not saturated: the inner
+	// edge is the side.
+	cv::Mat img(90, 90, CV_8UC3, cv::Scalar(30, 35, 30));
+	cv::rectangle(img, cv::Rect(10, 10, 56, 56), cv::Scalar(50, 60, 50), cv::FILLED);
+	cv::rectangle(img, cv::Rect(16, 16, 40, 40), kBlack, cv::FILLED);
+	cv::rectangle(img, cv::Rect(20, 20, 32, 32), cv::Scalar(40, 107, 50), cv::FILLED);
+	Candidate c;
+	c.bbox = cv::Rect(20, 20, 44, 32);
+	c.centroid = Eigen::Vector2d(35.5, 35.5);
+	c.fill_g = 107;
+	const auto domain = [](Polarity pol, Eigen::Vector2d a, Eigen::Vector2d b)
+	{
+		EdgelDomain d;
+		d.polarity = pol;
+		d.end0 = a;
+		d.end1 = b;
+		d.mean = 0.5 * (a + b);
+		d.dir = (b - a).normalized();
+		d.length_px = (b - a).norm();
+		d.count = static_cast<int>(d.length_px) + 1;
+		return d;
+	};
+	const std::vector<EdgelDomain> domains{
+		domain(Polarity::Top, {21, 19.5}, {50, 19.5}),
+		domain(Polarity::Right, {51.5, 21}, {51.5, 50}),
+		domain(Polarity::Bottom, {21, 51.5}, {50, 51.5}),
+		domain(Polarity::Left, {19.5, 21}, {19.5, 50}),
+		domain(Polarity::Right, {65.5, 12}, {65.5, 64})};
+	const auto s = selectSegments(domains, c, cv::Mat(), 2, SegmentParams(), &img);
+	ASSERT_TRUE(s);
+	EXPECT_NEAR((*s)[1].mean.x(), 51.5, 1e-9);
+}
+
 TEST(Quadrangle, RejectsSegmentsFarFromTheirCorners)
 {
 	SideSegments s;

@@ -79,7 +79,8 @@ DetectionResult detectWithModels(
 
 		// 5. Segment selection: size, polarity, slimness, relative length.
 		const auto sides = selectSegments(
-			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr, fill_ratio);
+			edgels.domains, cand, mask, opt.segmentation.step_px, opt.segments, &bgr, fill_ratio,
+			opt.segmentation);
 		tm.segments_us += microsSince(t);
 		if (debug) dbg.edgels.push_back(std::move(edgels));
 		if (!sides) continue;

@@ -1,4 +1,6 @@
 // Stages 4-6: edgels and their domains, side selection, quadrangle linking.
+#include <codemark/detect/colour.h>
+
 #include "stages.h"
 
 #include <opencv2/imgproc.hpp>
@@ -169,7 +171,8 @@ EdgelMap findEdgels(
 
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p, const cv::Mat* bgr, double fill_band_rel)
+	const SegmentParams& p, const cv::Mat* bgr, double fill_band_rel,
+	const SegmentationParams& colour)
 {
 	// The fill's colour in the image just inside a domain, at two of three
 	// points along it: 1.5 px inwards, 1 px beyond the edgel's rounding,
@@ -187,7 +190,13 @@ std::optional<SideSegments> selectSegments(
 					  y = static_cast<int>(std::lround(q.y()));
 			if (x < 0 || y < 0 || x >= bgr->cols || y >= bgr->rows) continue;
 			const uint8_t* px = bgr->ptr<uint8_t>(y) + 3 * x;
-			if (px[1] >= 0.5 * c.fill_g && px[1] > px[0] && px[1] > px[2]) ++hits;
+			// Green and saturated: at least half the fill's saturation floor
+			// (a codec's chroma, averaged over 2 px next to the achromatic
+			// frame, keeps half of it), which a grey wall tinted green by the
+			// white balance does not reach.
+			if (px[1] >= 0.5 * c.fill_g && px[1] > px[0] && px[1] > px[2] &&
+				hsiOf(px[2], px[1], px[0]).saturation >= 0.5 * colour.min_saturation)
+				++hits;
 		}
 		return hits >= 2;
 	};

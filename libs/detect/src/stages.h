@@ -142,7 +142,9 @@ using SideSegments = std::array<EdgelDomain, 4>;
  * it in \a mask (grid step \a step; an empty mask skips that test),
  * nearest the fill's bounding box side. With \a bgr given, the fill must
  * also be seen in the image right inside the domain (G at least half the
- * fill's, above R and B), 1.5 px plus half a gradient-image pixel inwards:
+ * fill's, above R and B, and at least half of \a colour's saturation floor:
+ * a grey wall with a tint of green is not the fill), 1.5 px plus half a
+ * gradient-image pixel inwards:
  * the grid mask is coarser, and the sheet's edge against a darker wall lies
  * only a thin frame (1.6-3.2 px at 5 m) outside the inner edge.
  * \a fill_band_rel is the green band between the inner edge and the code
@@ -152,7 +154,8 @@ using SideSegments = std::array<EdgelDomain, 4>;
  * not hide the fill. */
 std::optional<SideSegments> selectSegments(
 	const std::vector<EdgelDomain>& domains, const Candidate& c, const cv::Mat& mask, int step,
-	const SegmentParams& p, const cv::Mat* bgr = nullptr, double fill_band_rel = 35.0 / 160);
+	const SegmentParams& p, const cv::Mat* bgr = nullptr, double fill_band_rel = 35.0 / 160,
+	const SegmentationParams& colour = SegmentationParams());
 
 // ------------------------------------------------------------------ stage 6
 /** Coarse corners TL, TR, BR, BL [raw px]. */
