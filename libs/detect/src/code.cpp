@@ -44,11 +44,13 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v)
 
 double frameNeighbourShare(double width_px, double blur_px, double half_band)
 {
-	if (!(blur_px > 0) || !(width_px > 0)) return 0;
+	// Under two blur widths the dip's depth depends on the actual blur more
+	// than on the ink: no correction.
+	if (!(blur_px > 0) || !(width_px >= 2 * blur_px)) return 0;
 	const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
 	double share = 0;
 	for (int i = -2; i <= 2; ++i) share += phi(-(0.5 + half_band * i / 2.0) * width_px / blur_px);
-	return std::min(0.25, share / 5);
+	return share / 5;
 }
 
 FrameSurround frameSurround(

@@ -74,8 +74,8 @@ std::vector<Candidate> findCandidates(
  * share Phi(-(w/2 + x) / sigma) and Phi(-(w/2 - x) / sigma) of its level.
  * frameNeighbourShare() is that share averaged over the offsets
  * \a half_band x w x {-1, -1/2, 0, 1/2, 1} (the frame's samples; 0: its
- * middle alone), capped at 1/4 (a frame under about 1.3 sigma: the model
- * then corrects less than the blur lifts, never more).
+ * middle alone); 0 for a frame under two blur widths, whose depth depends
+ * on the actual blur more than on its ink.
  * unblurredFrameLevel() undoes it: the ink's level from the level
  * \a measured between neighbours \a inner and \a outer. */
 double frameNeighbourShare(double width_px, double blur_px, double half_band = 0);

@@ -79,8 +79,10 @@ struct ComponentParams
 	 * blur the detector is built for (Gaussian sigma, the target ranges'
 	 * 1.5 px) at the frame's width in pixels: a frame of 4 px (a 32 px
 	 * square) has about a tenth of each neighbour's level added, one of 10
-	 * px none. A sharper image is corrected more than it was lifted, which
-	 * the checks' margins absorb [px]. 0 reads the level as it is. */
+	 * px none; one under two blur widths (3 px) is read as it is, its
+	 * depth depending on the actual blur more than on its ink. A sharper
+	 * image is corrected more than it was lifted, which the checks'
+	 * margins absorb [px]. 0 reads every level as it is. */
 	double frame_blur_px = 1.5;
 	/** Centre evidence: the code board's centre cell is always black, so a
 	 * landmark's fill component has a hole at its centre. When the centre
