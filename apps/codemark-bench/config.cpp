@@ -28,13 +28,17 @@ std::string trim(const std::string& s)
 	return s.substr(a, s.find_last_not_of(" \t\r\n") - a + 1);
 }
 
+// "FILE:LINE: [SECTION] KEY: what" (the line where the file sets KEY; the
+// file alone when it does not), "FILE: [SECTION]: what" without a key.
 [[noreturn]] void fail(
 	const std::string& file, const std::string& section, const std::string& key,
 	const std::string& what)
 {
+	if (!key.empty())
+		throw std::runtime_error(
+			iniWhere(file, section, key) + "[" + section + "] " + key + ": " + what);
 	std::string where = file;
 	if (!section.empty()) where += ": [" + section + "]";
-	if (!key.empty()) where += " " + key;
 	throw std::runtime_error(where + ": " + what);
 }
 
@@ -113,7 +117,9 @@ BenchConfig loadBenchConfig(const std::string& path)
 			}
 			catch (const std::invalid_argument& e)
 			{
-				fail(path, "bench", "", e.what());
+				// parseMethods() names the key itself.
+				throw std::runtime_error(
+					iniWhere(path, "bench", "methods") + "[bench] " + e.what());
 			}
 		}
 		if (c.keyExists("bench", "config_dir"))

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # codemark-bench on bad benchmark inis: a non-zero exit and one line that
-# names the file, the section and the key, never a crash.
+# names the file, the line (for a key the file sets), the section and the
+# key, never a crash.
 # usage: bench_bad_ini.sh CODEMARK_BENCH DATA_DIR
 set -euo pipefail
 bench=$1 data=$2
@@ -23,15 +24,15 @@ gt = $data/gt_path.txt"
 
 expect missing "$tmp/missing.ini: cannot open"
 printf '[dataset:a]\n%s\nspeed = 3\n' "$good" > "$tmp/unknown_key.ini"
-expect unknown_key "unknown_key.ini: [dataset:a] speed: unknown key"
+expect unknown_key "unknown_key.ini:5: [dataset:a] speed: unknown key"
 printf '[dataset:a]\nrawlog = %s/annotated.rawlog\nmap = %s/map.txt\n' "$data" "$data" > "$tmp/no_gt.ini"
 expect no_gt "no_gt.ini: [dataset:a] gt: missing"
 printf '[dataset:a]\n%s\n' "${good/map.txt/nomap.txt}" > "$tmp/no_map_file.ini"
-expect no_map_file "no_map_file.ini: [dataset:a] map: $data/nomap.txt: no such file"
+expect no_map_file "no_map_file.ini:3: [dataset:a] map: $data/nomap.txt: no such file"
 printf '[bench]\nrpe_interval_s = 1.0x\n[dataset:a]\n%s\n' "$good" > "$tmp/bad_number.ini"
-expect bad_number "bad_number.ini: [bench] rpe_interval_s: '1.0x' is not a positive number"
+expect bad_number "bad_number.ini:2: [bench] rpe_interval_s: '1.0x' is not a positive number"
 printf '[bench]\nmethods = ekf, kalman\n[dataset:a]\n%s\n' "$good" > "$tmp/bad_method.ini"
-expect bad_method "bad_method.ini: [bench]: methods: unknown method 'kalman'"
+expect bad_method "bad_method.ini:2: [bench] methods: unknown method 'kalman'"
 printf '[datasets]\nx = 1\n' > "$tmp/bad_section.ini"
 expect bad_section "bad_section.ini: [datasets]: unknown section"
 printf '[bench]\nmin_span_px = 30\n' > "$tmp/no_dataset.ini"
