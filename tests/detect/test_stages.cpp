@@ -415,6 +415,24 @@ TEST(Quadrangle, GreenSquareOnBlackGivesAQuadrangle)
 	EXPECT_TRUE(coarseQuad(img));
 }
 
+namespace
+{
+/** A straight domain of polarity \a pol from \a a to \a b, one edgel a
+ * pixel. */
+EdgelDomain domain(Polarity pol, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
+{
+	EdgelDomain d;
+	d.polarity = pol;
+	d.end0 = a;
+	d.end1 = b;
+	d.mean = 0.5 * (a + b);
+	d.dir = (b - a).normalized();
+	d.length_px = (b - a).norm();
+	d.count = static_cast<int>(d.length_px) + 1;
+	return d;
+}
+}  // namespace
+
 TEST(Segments, AShortGhostBesideTheInnerEdgeDoesNotReplaceIt)
 {
 	// The fill's box spans [20, 52) both ways. Each side has its inner edge
@@ -424,18 +442,6 @@ TEST(Segments, AShortGhostBesideTheInnerEdgeDoesNotReplaceIt)
 	Candidate c;
 	c.bbox = cv::Rect(20, 20, 32, 32);
 	c.centroid = Eigen::Vector2d(35.5, 35.5);
-	const auto domain = [](Polarity pol, Eigen::Vector2d a, Eigen::Vector2d b)
-	{
-		EdgelDomain d;
-		d.polarity = pol;
-		d.end0 = a;
-		d.end1 = b;
-		d.mean = 0.5 * (a + b);
-		d.dir = (b - a).normalized();
-		d.length_px = (b - a).norm();
-		d.count = static_cast<int>(d.length_px) + 1;
-		return d;
-	};
 	std::vector<EdgelDomain> domains{
 		domain(Polarity::Top, {21, 20.5}, {50, 20.5}),
 		domain(Polarity::Right, {50.5, 21}, {50.5, 50}),
@@ -472,18 +478,6 @@ TEST(Segments, AGreenTintedWallIsNotTheFill)
 	c.bbox = cv::Rect(20, 20, 44, 32);
 	c.centroid = Eigen::Vector2d(35.5, 35.5);
 	c.fill_g = 107;
-	const auto domain = [](Polarity pol, Eigen::Vector2d a, Eigen::Vector2d b)
-	{
-		EdgelDomain d;
-		d.polarity = pol;
-		d.end0 = a;
-		d.end1 = b;
-		d.mean = 0.5 * (a + b);
-		d.dir = (b - a).normalized();
-		d.length_px = (b - a).norm();
-		d.count = static_cast<int>(d.length_px) + 1;
-		return d;
-	};
 	const std::vector<EdgelDomain> domains{
 		domain(Polarity::Top, {21, 19.5}, {50, 19.5}),
 		domain(Polarity::Right, {51.5, 21}, {51.5, 50}),

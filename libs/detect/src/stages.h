@@ -599,7 +599,7 @@ FrameSurround frameSurround(
  * green or a cell is ambiguous. */
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
-	const CodeParams& p, double frame_blur_px = 1.5);
+	const CodeParams& p, double frame_blur_px = ComponentParams().frame_blur_px);
 
 // ---------------------------------------------------------------- detector
 /** detect() with the sub-pixel stage's models switched by \a models (the
