@@ -255,3 +255,52 @@ TEST(EdgeModels, PolicyPicksTheLocatorFromTheSidesProperties)
 			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.05) << x.name << ", corner " << k;
 	}
 }
+
+// Stage 7b reads a side's frame across: both edges where the quiet margin
+// around the frame is resolved (the midline needs them), the inner edge
+// alone where it is not (the margin's edge would merge with the outer
+// one). A side read alone goes to its inner edge moved inwards by the
+// other sides' bend.
+TEST(Frame, AnUnresolvedMarginLeavesTheInnerEdge)
+{
+	const SubpixelParams p;
+	const double frame_ratio = 0.125;
+	const int side_px = 80, frame_px = 10;
+	const PrintImage img = printImage(side_px, frame_px, 180);
+	const auto q = refineQuadrangle(img.bgr, img.coarse, CameraModel(), 5, frame_ratio, p);
+	ASSERT_TRUE(q);
+	// The print's inner edges and its centre.
+	const double a = 2 * frame_px + 20 - 0.5, b = a + side_px, mid = 0.5 * (a + b);
+	const double inner[4] = {a, b, b, a};
+	for (int side = 0; side < 4; ++side)
+	{
+		SCOPED_TRACE("side " + std::to_string(side));
+		// A margin of 8 px (the wall is as bright as a sheet): both edges.
+		const auto wide =
+			readFrameSide(img.bgr, *q, side, CameraModel(), 5, frame_ratio, 0.1, p, 24);
+		ASSERT_TRUE(wide);
+		EXPECT_TRUE(wide->outer);
+		EXPECT_TRUE(midlineOfSide(*wide, *q, CameraModel(), frame_ratio, p));
+		// A margin of 0.4 px: the inner edge alone, in as many profiles.
+		const auto narrow =
+			readFrameSide(img.bgr, *q, side, CameraModel(), 5, frame_ratio, 0.005, p, 24);
+		ASSERT_TRUE(narrow);
+		EXPECT_FALSE(narrow->outer);
+		EXPECT_EQ(narrow->reads.size(), wide->reads.size());
+		for (const auto& r : narrow->reads) EXPECT_TRUE(std::isnan(r.e_out));
+		EXPECT_FALSE(midlineOfSide(*narrow, *q, CameraModel(), frame_ratio, p));
+		// Its line on the print's inner edge, and moved inwards by a bend.
+		const int across = side % 2 == 0 ? 1 : 0;
+		const double outward = inner[side] < mid ? -1 : 1;
+		for (const double shift : {0.0, 0.3})
+		{
+			const auto line = shiftedInnerLine(*narrow, shift, CameraModel(), p);
+			ASSERT_TRUE(line);
+			// The line's across coordinate at the side's middle.
+			const Eigen::Vector2d n = line->normal;
+			const double at =
+				across == 1 ? -(line->c + n.x() * mid) / n.y() : -(line->c + n.y() * mid) / n.x();
+			EXPECT_NEAR(at, inner[side] - outward * shift, 0.05) << "shift " << shift;
+		}
+	}
+}
