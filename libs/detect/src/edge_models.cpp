@@ -140,6 +140,10 @@ LocatorChoice chooseLocator(
 
 namespace
 {
+/** The farthest R + B's edge may lie from G's clipped peak [px]
+ * (ChannelsLocator). */
+constexpr double kMaxChannelOffsetPx = 0.75;
+
 class CentroidLocator : public EdgeLocator
 {
    public:
@@ -188,7 +192,12 @@ class ChannelsLocator : public EdgeLocator
 		const int k = static_cast<int>(std::lround(*g_peak));
 		const auto r =
 			locateRisingEdge(rb, n, k - 1, k + 1, p_.min_rise_rb, p_, EdgeMode::IsolatedCentroid);
-		return r ? r : g_peak;
+		// The clip pulls G's peak towards the frame by up to about 0.6 px
+		// (a fill at 1.4 times the sensor's top, blur 0.8 px): R + B
+		// farther from it than that is not the fill's edge (lateral
+		// chromatic aberration, a demosaicing's fringes, a transfer curve
+		// that bent it into the fill).
+		return r && std::abs(*r - *g_peak) <= kMaxChannelOffsetPx ? r : g_peak;
 	}
 
    private:
