@@ -882,14 +882,14 @@ int main(int argc, char** argv)
 				char data[400];
 				std::snprintf(
 					data, sizeof data,
-					"data: %s renderer, %s scene, camera preset %s, %d renders at %.1f-%.1f m, "
+					"data: %s renderer, %s, camera preset %s, %d renders at %.1f-%.1f m, "
 					"view angles up to %.0f deg; %zu detections, %d missed",
 					renderer_arg.getValue().c_str(),
 					realistic_arg.getValue()
 						? (vary_arg.getValue()
-							   ? "realistic (textured wall) with prints and lights varied"
-							   : "realistic (textured wall, light gradient)")
-						: "plain background",
+							   ? "realistic scene (textured wall) with prints and lights varied"
+							   : "realistic scene (textured wall, light gradient)")
+						: "plain background scene",
 					preset_arg.getValue().empty() ? "none" : preset_arg.getValue().c_str(),
 					n_arg.getValue(), dmin_arg.getValue(), dmax_arg.getValue(), amax_arg.getValue(),
 					samples.size(), missed);
