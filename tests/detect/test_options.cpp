@@ -122,7 +122,8 @@ TEST(Options, ShippedIniHoldsTheDefaults)
 }
 
 // A key the detector does not read is refused with its name, the file and
-// its line: a misspelt key would otherwise leave its default in force.
+// its line: a misspelt key would otherwise leave its default in force. A
+// value of the wrong type or out of range names its line too.
 TEST(Options, UnknownKeysAreRefusedWithFileAndLine)
 {
 	mrpt::config::CConfigFileMemory cfg;
@@ -161,5 +162,13 @@ TEST(Options, UnknownKeysAreRefusedWithFileAndLine)
 	}
 	what = thrownMessage<std::runtime_error>(load);
 	EXPECT_NE(what.find(path + ":3:"), std::string::npos) << what;
+	// And a value out of its range.
+	{
+		std::ofstream f(path);
+		f << "[DETECTOR]\nsegmentation.step_px = 2\ncomponents.frame_blur_px = -1\n";
+	}
+	what = thrownMessage<std::runtime_error>(load);
+	EXPECT_NE(what.find(path + ":3:"), std::string::npos) << what;
+	EXPECT_NE(what.find("components.frame_blur_px must be in [0, 10]"), std::string::npos) << what;
 	std::remove(path.c_str());
 }

@@ -16,15 +16,9 @@ namespace codemark::detect
 {
 namespace
 {
-void require(bool ok, const char* name, const char* rule)
-{
-	if (!ok)
-		throw std::invalid_argument(std::string("detector option ") + name + " must be " + rule);
-}
-
-/** A key refused while loading: std::invalid_argument, as
- * loadFromConfigFile() promises, that remembers the key so that load() can
- * name the file's line (iniWhere()). */
+/** A key refused while loading or validating: std::invalid_argument, as
+ * loadFromConfigFile() and validate() promise, that remembers the key so
+ * that load() can name the file's line (iniWhere()). */
 class KeyError : public std::invalid_argument
 {
    public:
@@ -34,6 +28,11 @@ class KeyError : public std::invalid_argument
 	}
 	std::string key;
 };
+
+void require(bool ok, const char* name, const char* rule)
+{
+	if (!ok) throw KeyError(name, std::string("detector option ") + name + " must be " + rule);
+}
 
 // Keys are "<block>.<field>", e.g. segmentation.step_px. A value that is
 // not one of its type is refused with the key and the text: MRPT's
