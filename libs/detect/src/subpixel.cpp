@@ -179,21 +179,8 @@ std::optional<double> locateRisingEdge(
 				for (int it = 0; it < 4 && var > 0; ++it)
 				{
 					const double o = e - neighbour_px;
-					// This peak's tail at the neighbour, from its spread on
-					// the neighbour's side: a transfer curve skews the
-					// response (longer on the dark side, shorter on the
-					// bright one), which the three samples' symmetric
-					// Gaussian misses, and the lobe's height with it.
 					const double g = [&]
-					{
-						const int k = before ? km : kp;
-						const double dk = d(k);
-						const double a2 = (k - e) * (k - e), b2 = (peak - e) * (peak - e);
-						const double side_var = dk > 0 && dk < dp && a2 > b2
-													? (a2 - b2) / (2 * std::log(dp / dk))
-													: var;
-						return std::exp(-neighbour_px * neighbour_px / (2 * side_var));
-					}();
+					{ return std::exp(-neighbour_px * neighbour_px / (2 * var)); }();
 					const double B = -lowest + amp * g;
 					const auto lobe = [&](int k)
 					{ return B * std::exp(-(k - o) * (k - o) / (2 * var)); };
