@@ -91,7 +91,7 @@ Eigen::Vector2d innerEdgePoint(
 std::optional<FrameSide> readFrameSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& cam, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
-	EdgeMode mode)
+	double offset)
 {
 	const bool distorted = cam.hasDistortion();
 	const FaceMap map{faceToImage(q.corners_ideal), cam, distorted};
@@ -124,7 +124,7 @@ std::optional<FrameSide> readFrameSide(
 	// mosaic's rows and of a JPEG's blocks.
 	const int stride = std::max(1, (last - first + 1) / std::max(1, max_profiles)) | 1;
 	size_t at_inner = 0, at_outer = 0, at_sheet = 0;
-	for (int s = first; s <= last; s += stride)
+	for (int s = first + static_cast<int>(offset * stride); s <= last; s += stride)
 	{
 		const auto c_in = acrossAt(inner, along, s, at_inner),
 				   c_out = acrossAt(outer, along, s, at_outer),
@@ -163,14 +163,14 @@ std::optional<FrameSide> readFrameSide(
 		const int ki = static_cast<int>(std::lround(inward * (*c_in - base))),
 				  ko = static_cast<int>(std::lround(inward * (*c_out - base)));
 		const auto e_in =
-			locateRisingEdge(v.data(), n, ki - kSearch, ki + kSearch, min_rise, p, mode);
+			locateRisingEdge(v.data(), n, ki - kSearch, ki + kSearch, min_rise, p, EdgeMode::Peak);
 		if (!e_in) continue;
 		vr.assign(v.rbegin(), v.rend());
 		const auto e_out_r = margin < kMinMarginPx
 								 ? std::nullopt
 								 : locateRisingEdge(
 									   vr.data(), n, n - 1 - ko - kSearch, n - 1 - ko + kSearch,
-									   min_rise, p, mode, -margin);
+									   min_rise, p, EdgeMode::Peak, -margin);
 		double e_out = std::numeric_limits<double>::quiet_NaN();
 		if (e_out_r)
 		{
@@ -289,17 +289,15 @@ void centreOnFrame(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& cam, double min_rise, double frame_ratio,
 	double margin_ratio, const SubpixelParams& p)
 {
-	// The first pass decides on a few profiles a side (kDecisionProfiles),
-	// each edge at the log-parabola's peak (a few hundredths of a pixel
-	// from the step model's, at a fraction of its cost: most landmarks in
-	// linear light stop here): where the frame reads as wide as the
-	// homography says, within the midline's own scatter, or wider
-	// (printers' dot gain widens it), there is no bend to undo, and the
-	// single-edge models (exact in linear light, with their restoration of
-	// a clipped fill) stay. A transfer curve bends every side of the
-	// landmark alike: the decision is the sides' median, and a side whose
-	// quiet margin is unresolved (its outer edge merges with the margin's)
-	// takes its inner edge moved by that median.
+	// The first pass decides on a few profiles a side (kDecisionProfiles):
+	// where the frame reads as wide as the homography says, within the
+	// midline's own scatter, or wider (printers' dot gain widens it), there
+	// is no bend to undo, and the single-edge models (exact in linear
+	// light, with their restoration of a clipped fill) stay. A transfer
+	// curve bends every side of the landmark alike: the decision is the
+	// sides' median, and a side whose quiet margin is unresolved (its outer
+	// edge merges with the margin's) takes its inner edge moved by that
+	// median.
 	std::array<std::optional<FrameSide>, 4> read;
 	RefinedQuad next = q;
 	const auto pass = [&](const RefinedQuad& square)
@@ -325,18 +323,34 @@ void centreOnFrame(
 	};
 	for (int side = 0; side < 4; ++side)
 		read[side] = readFrameSide(
-			bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p, kDecisionProfiles,
-			EdgeMode::PeakGaussian);
+			bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p, kDecisionProfiles);
 	const double common = pass(q);
 	if (!(common >= kMinShiftPx) || !cornersFromSides(next, cam)) return;
-	// The second pass reads each side again on more profiles, each edge
-	// with the step model, around the first pass's square, and places
-	// every reading's midline with that square's frame widths: the widths,
-	// not the edges, depend on the square.
+	// The second pass reads each side on more profiles between the first's,
+	// around the first pass's square, and places every reading's midline
+	// with that square's frame widths: the widths, not the edges, depend on
+	// the square.
 	const RefinedQuad first = next;
 	for (int side = 0; side < 4; ++side)
-		read[side] = readFrameSide(
-			bgr, first, side, cam, min_rise, frame_ratio, margin_ratio, p, kLineProfiles);
+	{
+		if (!read[side]) continue;
+		if (const auto more = readFrameSide(
+				bgr, first, side, cam, min_rise, frame_ratio, margin_ratio, p,
+				kLineProfiles - kDecisionProfiles, 0.5))
+		{
+			auto& r = read[side]->reads;
+			r.insert(r.end(), more->reads.begin(), more->reads.end());
+			std::sort(
+				r.begin(), r.end(),
+				[](const FrameReading& x, const FrameReading& y) { return x.s < y.s; });
+			r.erase(
+				std::unique(
+					r.begin(), r.end(),
+					[](const FrameReading& x, const FrameReading& y) { return x.s == y.s; }),
+				r.end());
+			read[side]->outer = read[side]->outer && more->outer;
+		}
+	}
 	if (std::isnan(pass(first)) || !cornersFromSides(next, cam)) return;
 	q = std::move(next);
 }

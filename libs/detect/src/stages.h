@@ -499,16 +499,16 @@ struct FrameSide
 };
 
 /** Side \a side's black frame read across, in at most about \a
- * max_profiles profiles evenly spread along it (an odd stride): per
- * profile the inner and the outer edge of the frame (locateRisingEdge() in
- * \a mode, mirrored for the outer one) and the levels next
+ * max_profiles profiles evenly spread along it (an odd stride, the first
+ * \a offset strides from the side's start): per profile the inner and the
+ * outer edge of the frame (the same locator, mirrored) and the levels next
  * to them; the outer edge only where the quiet margin is resolved (\a
  * margin_ratio: its width over the inner side; FrameSide::outer). Nullopt
  * where no profile reads the inner edge. */
 std::optional<FrameSide> readFrameSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
-	EdgeMode mode = EdgeMode::Peak);
+	double offset = 0);
 
 /** The side's line on the frame's midline, the frame's width at each
  * reading from \a q's homography: the missing width shared between the
@@ -540,7 +540,7 @@ std::optional<FrameMidline> frameMidlineSide(
  * its edges), each such side goes to the frame's midline and each side
  * with an unresolved margin to its inner edge moved by that median
  * (shiftedInnerLine()), twice (the second time with the frame's widths
- * from the first's square, on more profiles), and the corners follow;
+ * from the first's square, on more readings), and the corners follow;
  * otherwise \a q stays as it is. */
 void centreOnFrame(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,

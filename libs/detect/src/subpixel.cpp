@@ -106,7 +106,6 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 		cand[0] = std::clamp(cand[0], peak - 1.0, peak + 1.0);
 		cand[1] = std::clamp(cand[1], kMinSigma, kMaxSigma);
 		cand[2] = std::max(cand[2], 1e-9);
-		if (std::abs(cand[0] - q[0]) < 1e-3 && std::abs(cand[1] - q[1]) < 1e-2) break;
 		Eigen::Matrix3d Jc;
 		const Eigen::Vector3d rc = model(cand, &Jc);
 		if (rc.squaredNorm() < cost)
@@ -116,7 +115,7 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 			J = Jc;
 			cost = rc.squaredNorm();
 			mu = std::max(1e-9, mu * 0.3);
-			if (std::abs(step[0]) < 1e-3 && std::abs(step[1]) < 1e-2) break;
+			if (std::abs(step[0]) < 1e-4 && std::abs(step[1]) < 1e-3) break;
 		}
 		else
 			mu *= 10;
