@@ -28,10 +28,11 @@ constexpr double kMinMarginPx = 1.0;
 /** ... and the narrowest in units of the edge's blur sigma: the half width
  * at half maximum of its derivative, sqrt(2 ln 2). */
 const double kMarginBlurs = std::sqrt(2 * std::log(2.0));
-/** The smallest median shift over a landmark's sides [px] for which the
+/** The smallest shift of every side of a landmark [px] for which the
  * midline replaces the single-edge lines: the frame read 0.2 px narrower
- * than the homography's width, beyond what a clip in linear light and the
- * peak locator's own scatter do; a transfer curve does more. */
+ * than the homography's width on all four sides, beyond what a clip in
+ * linear light and the peak locator's own scatter do to one; a transfer
+ * curve does more to each. */
 constexpr double kMinShiftPx = 0.1;
 /** Profiles read a side at most: for the decision and the first square
  * (the second pass's frame widths), and for the final line. The midline's
@@ -80,14 +81,6 @@ std::vector<Eigen::Vector2d> sidePolyline(
 }
 }  // namespace
 
-Eigen::Vector2d innerEdgePoint(
-	const FrameSide& f, const FrameReading& r, double shift, const CameraModel& cam)
-{
-	const double c = r.base + f.inward * (r.e_in + shift);
-	const Eigen::Vector2d pt = f.along == 1 ? Eigen::Vector2d(c, r.s) : Eigen::Vector2d(r.s, c);
-	return cam.hasDistortion() ? cam.undistortPixel(pt) : pt;
-}
-
 std::optional<FrameSide> readFrameSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& cam, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
@@ -134,8 +127,8 @@ std::optional<FrameSide> readFrameSide(
 		const double width = inward * (*c_in - *c_out);
 		// The margin's edge within a pixel of the frame's: its lobe merges
 		// with the outer edge's and cannot be removed (far or steep views;
-		// the spec's 5 mm margin is a quarter of the frame): the outer edge
-		// is not read.
+		// the spec's 5 mm margin is a quarter of the frame).
+		if (margin < kMinMarginPx) return std::nullopt;
 		min_margin = std::min(min_margin, margin);
 		// Profile index i <-> across coordinate base + inward * i, pointing
 		// into the fill.
@@ -164,19 +157,14 @@ std::optional<FrameSide> readFrameSide(
 				  ko = static_cast<int>(std::lround(inward * (*c_out - base)));
 		const auto e_in =
 			locateRisingEdge(v.data(), n, ki - kSearch, ki + kSearch, min_rise, p, EdgeMode::Peak);
-		if (!e_in) continue;
 		vr.assign(v.rbegin(), v.rend());
-		const auto e_out_r = margin < kMinMarginPx
-								 ? std::nullopt
-								 : locateRisingEdge(
-									   vr.data(), n, n - 1 - ko - kSearch, n - 1 - ko + kSearch,
-									   min_rise, p, EdgeMode::Peak, -margin);
-		double e_out = std::numeric_limits<double>::quiet_NaN();
-		if (e_out_r)
-		{
-			const double measured = *e_in - (n - 1 - *e_out_r);
-			if (measured >= 0.5 * width && measured <= 1.5 * width) e_out = n - 1 - *e_out_r;
-		}
+		const auto e_out_r = locateRisingEdge(
+			vr.data(), n, n - 1 - ko - kSearch, n - 1 - ko + kSearch, min_rise, p, EdgeMode::Peak,
+			-margin);
+		if (!e_in || !e_out_r) continue;
+		const double e_out = n - 1 - *e_out_r;
+		const double measured = *e_in - e_out;
+		if (measured < 0.5 * width || measured > 1.5 * width) continue;
 		FrameReading r{s, base, *e_in, e_out, width, 255, 0, 0, 0};
 		{
 			// The inner edge's blur: the spread of its central differences
@@ -205,12 +193,14 @@ std::optional<FrameSide> readFrameSide(
 	// The margin must be resolved: where its edge lies within the half
 	// maximum of the frame's outer edge's response, the two merge and the
 	// lobe model leaves part of the wall's pull.
-	std::vector<double> var;
-	var.reserve(reads.size());
-	for (const auto& r : reads) var.push_back(r.blur_var);
-	std::nth_element(var.begin(), var.begin() + var.size() / 2, var.end());
-	const double blur = std::sqrt(std::max(0.0, var[var.size() / 2]));
-	out.outer = min_margin >= std::max(kMinMarginPx, kMarginBlurs * blur);
+	{
+		std::vector<double> var;
+		var.reserve(reads.size());
+		for (const auto& r : reads) var.push_back(r.blur_var);
+		std::nth_element(var.begin(), var.begin() + var.size() / 2, var.end());
+		const double blur = std::sqrt(std::max(0.0, var[var.size() / 2]));
+		if (min_margin < kMarginBlurs * blur) return std::nullopt;
+	}
 	return out;
 }
 
@@ -218,7 +208,6 @@ std::optional<FrameMidline> midlineOfSide(
 	const FrameSide& f, const RefinedQuad& q, const CameraModel& cam, double frame_ratio,
 	const SubpixelParams& p)
 {
-	if (!f.outer) return std::nullopt;
 	// The bend of an edge grows with its contrast: through sRGB or a gamma
 	// of 1.8-2.6, as the square root of the encoded step from the same
 	// black within 5% (fill and sheet levels from 0.3 to 1 in linear
@@ -227,9 +216,7 @@ std::optional<FrameMidline> midlineOfSide(
 	{
 		std::vector<int> x;
 		x.reserve(f.reads.size());
-		for (const auto& r : f.reads)
-			if (!std::isnan(r.e_out)) x.push_back(level(r));
-		if (x.empty()) return 1;
+		for (const auto& r : f.reads) x.push_back(level(r));
 		std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
 		return std::max(1, x[x.size() / 2]);
 	};
@@ -243,36 +230,29 @@ std::optional<FrameMidline> midlineOfSide(
 	const Eigen::Vector2d &f0 = kFaceCorners[f.side], &f1 = kFaceCorners[(f.side + 1) % 4];
 	const auto inner = sidePolyline(map, f0, f1, 0, f.along);
 	const auto outer = sidePolyline(map, f0, f1, 2 * frame_ratio, f.along);
-	size_t at_inner = 0, at_out = 0;
+	size_t at_inner = 0, at_outer = 0;
 	std::vector<Eigen::Vector2d> pts;
 	std::vector<double> shifts;
 	pts.reserve(f.reads.size());
 	shifts.reserve(f.reads.size());
 	for (const auto& r : f.reads)
 	{
-		if (std::isnan(r.e_out)) continue;
 		const auto c_in = acrossAt(inner, f.along, r.s, at_inner),
-				   c_out = acrossAt(outer, f.along, r.s, at_out);
+				   c_out = acrossAt(outer, f.along, r.s, at_outer);
 		if (!c_in || !c_out) continue;
 		const double width = f.inward * (*c_in - *c_out);
 		const double shift = share_in * (width - (r.e_in - r.e_out));
 		shifts.push_back(shift);
-		pts.push_back(innerEdgePoint(f, r, shift, cam));
+		const double c = r.base + f.inward * (r.e_in + shift);
+		Eigen::Vector2d pt = f.along == 1 ? Eigen::Vector2d(c, r.s) : Eigen::Vector2d(r.s, c);
+		if (distorted) pt = cam.undistortPixel(pt);
+		pts.push_back(pt);
 	}
 	if (shifts.empty()) return std::nullopt;
 	auto line = fitLine(std::move(pts), p);
 	if (!line) return std::nullopt;
 	std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
 	return FrameMidline{std::move(*line), shifts[shifts.size() / 2]};
-}
-
-std::optional<LineFit> shiftedInnerLine(
-	const FrameSide& f, double shift, const CameraModel& cam, const SubpixelParams& p)
-{
-	std::vector<Eigen::Vector2d> pts;
-	pts.reserve(f.reads.size());
-	for (const auto& r : f.reads) pts.push_back(innerEdgePoint(f, r, shift, cam));
-	return fitLine(std::move(pts), p);
 }
 
 std::optional<FrameMidline> frameMidlineSide(
@@ -290,47 +270,32 @@ void centreOnFrame(
 	double margin_ratio, const SubpixelParams& p)
 {
 	// The first pass decides on a few profiles a side (kDecisionProfiles):
-	// where the frame reads as wide as the homography says, within the
-	// midline's own scatter, or wider (printers' dot gain widens it), there
-	// is no bend to undo, and the single-edge models (exact in linear
-	// light, with their restoration of a clipped fill) stay. A transfer
-	// curve bends every side of the landmark alike: the decision is the
-	// sides' median, and a side whose quiet margin is unresolved (its outer
-	// edge merges with the margin's) takes its inner edge moved by that
-	// median.
+	// where one side's frame reads as wide as the homography says, within
+	// the midline's own scatter, or wider (printers' dot gain widens it),
+	// there is no bend to undo, and the single-edge models (exact in
+	// linear light, with their restoration of a clipped fill) stay. A
+	// transfer curve bends every side of the landmark alike.
 	std::array<std::optional<FrameSide>, 4> read;
 	RefinedQuad next = q;
-	const auto pass = [&](const RefinedQuad& square)
-	{
-		std::vector<double> shifts;
-		for (int side = 0; side < 4; ++side)
-		{
-			if (!read[side]) continue;
-			auto m = midlineOfSide(*read[side], square, cam, frame_ratio, p);
-			if (!m) continue;
-			shifts.push_back(m->shift_px);
-			next.sides[side] = std::move(m->line);
-		}
-		if (shifts.empty()) return std::numeric_limits<double>::quiet_NaN();
-		std::sort(shifts.begin(), shifts.end());
-		const size_t k = shifts.size();
-		const double common = 0.5 * (shifts[(k - 1) / 2] + shifts[k / 2]);
-		for (int side = 0; side < 4; ++side)
-			if (read[side] && !read[side]->outer)
-				if (auto line = shiftedInnerLine(*read[side], common, cam, p))
-					next.sides[side] = std::move(*line);
-		return common;
-	};
+	int count = 0;
 	for (int side = 0; side < 4; ++side)
+	{
 		read[side] = readFrameSide(
 			bgr, q, side, cam, min_rise, frame_ratio, margin_ratio, p, kDecisionProfiles);
-	const double common = pass(q);
-	if (!(common >= kMinShiftPx) || !cornersFromSides(next, cam)) return;
-	// The second pass reads each side on more profiles between the first's,
-	// around the first pass's square, and places every reading's midline
-	// with that square's frame widths: the widths, not the edges, depend on
-	// the square.
+		if (!read[side]) continue;
+		auto m = midlineOfSide(*read[side], q, cam, frame_ratio, p);
+		if (!m) continue;
+		if (m->shift_px < kMinShiftPx) return;
+		next.sides[side] = std::move(m->line);
+		++count;
+	}
+	if (count == 0 || !cornersFromSides(next, cam)) return;
+	// The second pass reads each such side on more profiles between the
+	// first's, around the first pass's square, and places every reading's
+	// midline with that square's frame widths: the widths, not the edges,
+	// depend on the square.
 	const RefinedQuad first = next;
+	count = 0;
 	for (int side = 0; side < 4; ++side)
 	{
 		if (!read[side]) continue;
@@ -348,10 +313,13 @@ void centreOnFrame(
 					r.begin(), r.end(),
 					[](const FrameReading& x, const FrameReading& y) { return x.s == y.s; }),
 				r.end());
-			read[side]->outer = read[side]->outer && more->outer;
 		}
+		auto m = midlineOfSide(*read[side], first, cam, frame_ratio, p);
+		if (!m) continue;
+		next.sides[side] = std::move(m->line);
+		++count;
 	}
-	if (std::isnan(pass(first)) || !cornersFromSides(next, cam)) return;
+	if (count == 0 || !cornersFromSides(next, cam)) return;
 	q = std::move(next);
 }
 

@@ -483,7 +483,7 @@ struct FrameReading
 	int s, base;  //!< along coordinate; across coordinate of sample 0 [px]
 	/** The inner and outer edges [samples from base, into the fill] and
 	 * the frame's width the reading's square predicted [px]. */
-	double e_in, e_out, width;	//!< e_out NaN: not read
+	double e_in, e_out, width;
 	int dark, fill, sheet;	//!< G of the frame, the fill and the sheet
 	double blur_var;  //!< the inner edge's blur variance [px^2]
 };
@@ -492,9 +492,6 @@ struct FrameReading
 struct FrameSide
 {
 	int side = 0, along = 1, inward = 1;
-	/** The quiet margin is resolved and the readings hold the outer edge
-	 * (FrameReading::e_out NaN where it was not found). */
-	bool outer = true;
 	std::vector<FrameReading> reads;  //!< ordered along
 };
 
@@ -502,9 +499,8 @@ struct FrameSide
  * max_profiles profiles evenly spread along it (an odd stride, the first
  * \a offset strides from the side's start): per profile the inner and the
  * outer edge of the frame (the same locator, mirrored) and the levels next
- * to them; the outer edge only where the quiet margin is resolved (\a
- * margin_ratio: its width over the inner side; FrameSide::outer). Nullopt
- * where no profile reads the inner edge. */
+ * to them. Nullopt where the quiet margin is unresolved (\a margin_ratio:
+ * its width over the inner side) or no profile reads both edges. */
 std::optional<FrameSide> readFrameSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
@@ -518,30 +514,17 @@ std::optional<FrameMidline> midlineOfSide(
 	const FrameSide& f, const RefinedQuad& q, const CameraModel& camera, double frame_ratio,
 	const SubpixelParams& p);
 
-/** A side's inner edge [ideal px] at reading \a r moved inwards by \a
- * shift [px]. */
-Eigen::Vector2d innerEdgePoint(
-	const FrameSide& f, const FrameReading& r, double shift, const CameraModel& camera);
-
-/** The line through \a f's inner edges moved inwards by \a shift [px]:
- * a side whose quiet margin is unresolved, moved by the other sides'
- * midline shift. */
-std::optional<LineFit> shiftedInnerLine(
-	const FrameSide& f, double shift, const CameraModel& camera, const SubpixelParams& p);
-
 /** readFrameSide() and midlineOfSide() on the same square. */
 std::optional<FrameMidline> frameMidlineSide(
 	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles);
 
-/** Stage 7b: where the median of midlineOfSide()'s shifts over the sides
- * whose outer edge is read is at least 0.1 px inwards (the frame reads
- * narrower than the homography's width: a transfer curve or a clip bent
- * its edges), each such side goes to the frame's midline and each side
- * with an unresolved margin to its inner edge moved by that median
- * (shiftedInnerLine()), twice (the second time with the frame's widths
- * from the first's square, on more readings), and the corners follow;
- * otherwise \a q stays as it is. */
+/** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
+ * on every side it reads (the frame reads narrower than the homography's
+ * width all round: a transfer curve or a clip bent its edges), each side
+ * goes to the frame's midline, twice (the second time with the frame's
+ * widths from the first's square, on the same readings), and the corners
+ * follow; otherwise \a q stays as it is. */
 void centreOnFrame(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, double margin_ratio, const SubpixelParams& p);
