@@ -133,9 +133,10 @@ TEST(Camera, LoadsOpenCvYaml)
 	const auto p = writeTemp(
 		"cam_cv.yaml",
 		"%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  "
-		"rows: 3\n  cols: 3\n  dt: d\n  data: [ 810., 0., 320., 0., 805., 240., 0., 0., 1. "
-		"]\ndistortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  dt: d\n  data: [ "
-		"-0.2, 0.03, 0., 0., 0. ]\n");
+		"rows: 3\n  cols: 3\n  dt: d\n  data: [ 810., 0., 320.,\n        0., 805., 240.,\n     0., "
+		"0., 1. ]\n# a comment\ndistortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  "
+		"dt: d\n  data: [ -0.2, 0.03, 0., 0., 0. ]\n");
+	// The data's continuation lines sit at any indentation inside '[ ]'.
 	const CameraModel c = CameraModel::load(p);
 	EXPECT_DOUBLE_EQ(c.fx(), 810);
 	EXPECT_DOUBLE_EQ(c.fy(), 805);

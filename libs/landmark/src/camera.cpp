@@ -6,7 +6,6 @@
 
 #include <Eigen/Dense>
 #include <opencv2/core.hpp>
-#include <opencv2/core/persistence.hpp>
 
 #include <unistd.h>
 
@@ -66,105 +65,6 @@ bool startsWithOpenCvYaml(const std::string& path)
 	std::stringstream all;
 	all << f.rdbuf();
 	return first.rfind("%YAML:", 0) == 0 || all.str().find("!!opencv-matrix") != std::string::npos;
-}
-
-/** Refuses what no OpenCV camera YAML holds but makes OpenCV 4.6's YAML
- * reader (cv::FileStorage) loop forever, found by fuzzing: a document
- * start '---' with text after it on its line, followed by a line that
- * holds '---' ("%YAML:1.0\n---a:0\n1---\n"). Such files, as OpenCV and
- * camera calibration tools write them, start a document with a bare
- * '---' line; they hold no control characters either. Say so instead of
- * hanging. */
-void requireOpenCvYamlText(const std::string& path)
-{
-	std::ifstream in(path, std::ios::binary);
-	std::string text_line;
-	int line = 0;
-	while (std::getline(in, text_line))
-	{
-		++line;
-		if (!text_line.empty() && text_line.back() == '\r') text_line.pop_back();
-		for (const char ch : text_line)
-		{
-			const auto u = static_cast<unsigned char>(ch);
-			if ((u < 0x20 && u != '\t') || u == 0x7f)
-				throw std::runtime_error(
-					path + ":" + std::to_string(line) + ": control character in a YAML text file");
-		}
-		if (text_line.rfind("---", 0) == 0 &&
-			text_line.find_first_not_of(" \t", 3) != std::string::npos)
-			throw std::runtime_error(
-				path + ":" + std::to_string(line) +
-				": text after the document start '---' (expected '---' alone on its line)");
-	}
-}
-
-mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
-{
-	requireOpenCvYamlText(path);
-	cv::FileStorage fs;
-	try
-	{
-		fs.open(path, cv::FileStorage::READ);
-	}
-	catch (const cv::Exception& e)
-	{
-		throw std::runtime_error(path + ": cannot parse OpenCV YAML: " + e.err);
-	}
-	if (!fs.isOpened()) throw std::runtime_error(path + ": cannot parse OpenCV YAML");
-	// OpenCV allocates rows x cols as the file says before reading the data
-	// (a damaged 'rows' asked it for 48 GB in fuzzing): check the sizes first.
-	auto dims = [&](const char* key, int max_total)
-	{
-		const cv::FileNode n = fs[key];
-		if (n.empty() || n.isNone()) return 0;
-		if (!n.isMap() || !n["rows"].isInt() || !n["cols"].isInt())
-			throw std::runtime_error(path + ": '" + key + "' is not an !!opencv-matrix");
-		const int r = static_cast<int>(n["rows"]), c = static_cast<int>(n["cols"]);
-		if (r < 1 || c < 1 || r > max_total || c > max_total || r * c > max_total)
-			throw std::runtime_error(
-				path + ": '" + key + "' has " + std::to_string(r) + "x" + std::to_string(c) +
-				" entries");
-		return r * c;
-	};
-	if (dims("camera_matrix", 9) != 9)
-		throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
-	dims("distortion_coefficients", 8);
-	cv::Mat K, D;
-	try
-	{
-		fs["camera_matrix"] >> K;
-		fs["distortion_coefficients"] >> D;
-	}
-	catch (const cv::Exception& e)
-	{
-		throw std::runtime_error(path + ": bad OpenCV YAML matrix: " + e.err);
-	}
-	int w = 0, h = 0;
-	fs["image_width"] >> w;
-	fs["image_height"] >> h;
-	if (K.rows != 3 || K.cols != 3)
-		throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
-	if (w <= 0 || h <= 0)
-		throw std::runtime_error(path + ": expected positive 'image_width' and 'image_height'");
-	K.convertTo(K, CV_64F);
-	mrpt::img::TCamera c;
-	c.ncols = static_cast<uint32_t>(w);
-	c.nrows = static_cast<uint32_t>(h);
-	c.setIntrinsicParamsFromValues(
-		K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2));
-	c.distortion = mrpt::img::DistortionModel::none;
-	if (!D.empty())
-	{
-		D.convertTo(D, CV_64F);
-		const int n = static_cast<int>(D.total());
-		if (n != 4 && n != 5 && n != 8)
-			throw std::runtime_error(
-				path + ": 'distortion_coefficients' must have 4, 5 or 8 entries");
-		c.distortion = mrpt::img::DistortionModel::plumb_bob;
-		for (int i = 0; i < n; ++i) c.dist[i] = D.at<double>(i);
-	}
-	return c;
 }
 
 /** Runs \a f with the process' stderr (file descriptor 2) sent to a
@@ -248,10 +148,8 @@ void requireYamlNumbers(
  * malformed plain scalar (a segfault in its own error report). Camera files
  * are plain ASCII text without directives, indented with spaces; say so
  * instead of hanging or crashing. */
-void requirePlainYamlText(const std::string& path)
+void requirePlainYamlText(const std::string& path, const std::string& text)
 {
-	std::ifstream in(path, std::ios::binary);
-	const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 	int line = 1;
 	bool line_start = true;	 // YAML breaks lines at '\n', '\r' and "\r\n"
 	for (std::size_t i = 0; i < text.size(); ++i)
@@ -278,14 +176,22 @@ void requirePlainYamlText(const std::string& path)
 	}
 }
 
-mrpt::img::TCamera loadRosYaml(const std::string& path)
+std::string fileText(const std::string& path)
 {
-	requirePlainYamlText(path);
+	std::ifstream in(path, std::ios::binary);
+	return {(std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()};
+}
+
+/** \a text (the file \a path holds) parsed by MRPT's YAML reader, its
+ * syntax errors thrown as "PATH:LINE:COL: error: MESSAGE". */
+mrpt::containers::yaml parseYaml(const std::string& path, const std::string& text)
+{
+	requirePlainYamlText(path, text);
 	mrpt::containers::yaml y;
 	std::string diagnostics;
 	try
 	{
-		diagnostics = capturingStderr([&]() { y = mrpt::containers::yaml::FromFile(path); });
+		diagnostics = capturingStderr([&]() { y = mrpt::containers::yaml::FromText(text); });
 	}
 	catch (const std::exception& e)
 	{
@@ -301,6 +207,90 @@ mrpt::img::TCamera loadRosYaml(const std::string& path)
 		throw std::runtime_error(
 			path + ":" + (close == std::string::npos ? " " + line : line.substr(close + 2)));
 	}
+	return y;
+}
+
+/** The finite numbers of the YAML sequence (or scalar) \a node. */
+std::vector<double> yamlNumbers(
+	const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
+{
+	requireYamlNumbers(node, what, path);
+	std::vector<double> values;
+	auto add = [&](const auto& scalar)
+	{ values.push_back(*parseFiniteNumber(scalar.template as<std::string>())); };
+	if (node.isSequence())
+		for (const auto& v : node.asSequence()) add(v);
+	else
+		add(node);
+	return values;
+}
+
+/** OpenCV's camera YAML (cv::FileStorage, as OpenCV's calibration sample
+ * writes it): image_width, image_height, camera_matrix and
+ * distortion_coefficients as !!opencv-matrix maps (rows, cols, dt, data).
+ * Read by the same YAML reader as the ROS format, not by cv::FileStorage:
+ * OpenCV 4.6's reader loops forever on some malformed files (found by
+ * fuzzing), and one reader guarded against its failures serves both
+ * formats. Its "%YAML:1.0" first line is OpenCV's own spelling of a
+ * directive; it is blanked, keeping the line numbers. */
+mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
+{
+	std::string text = fileText(path);
+	if (text.rfind("%YAML:", 0) == 0) text.erase(0, text.find_first_of("\r\n"));
+	const mrpt::containers::yaml y = parseYaml(path, text);
+	if (!y.isMap()) throw std::runtime_error(path + ": expected a YAML map of camera keys");
+	auto matrix = [&](const char* key, size_t max_entries)
+	{
+		const auto& m = y[key];
+		if (!m.isMap() || !m.has("data"))
+			throw std::runtime_error(
+				path + ": '" + key + "' is not an !!opencv-matrix with 'data'");
+		const std::vector<double> data = yamlNumbers(m["data"], std::string(key) + ".data", path);
+		if (m.has("rows") && m.has("cols"))
+		{
+			const auto r = yamlNumbers(m["rows"], std::string(key) + ".rows", path);
+			const auto c = yamlNumbers(m["cols"], std::string(key) + ".cols", path);
+			if (r.size() != 1 || c.size() != 1 || r[0] * c[0] != double(data.size()))
+				throw std::runtime_error(
+					path + ": '" + key + "' has rows x cols unlike its " +
+					std::to_string(data.size()) + " data entries");
+		}
+		if (data.size() > max_entries)
+			throw std::runtime_error(
+				path + ": '" + key + "' has " + std::to_string(data.size()) + " entries");
+		return data;
+	};
+	for (const char* key : {"image_width", "image_height", "camera_matrix"})
+		if (!y.has(key))
+			throw std::runtime_error(path + ": missing required key '" + std::string(key) + "'");
+	const auto w = yamlNumbers(y["image_width"], "image_width", path);
+	const auto h = yamlNumbers(y["image_height"], "image_height", path);
+	if (w.size() != 1 || h.size() != 1 || !(w[0] >= 1 && w[0] <= 1e6) ||
+		!(h[0] >= 1 && h[0] <= 1e6) || w[0] != std::floor(w[0]) || h[0] != std::floor(h[0]))
+		throw std::runtime_error(
+			path + ": expected positive integer 'image_width' and 'image_height'");
+	const std::vector<double> K = matrix("camera_matrix", 9);
+	if (K.size() != 9) throw std::runtime_error(path + ": expected a 3x3 'camera_matrix'");
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(w[0]);
+	c.nrows = static_cast<uint32_t>(h[0]);
+	c.setIntrinsicParamsFromValues(K[0], K[4], K[2], K[5]);
+	c.distortion = mrpt::img::DistortionModel::none;
+	if (y.has("distortion_coefficients") && !y["distortion_coefficients"].isNullNode())
+	{
+		const std::vector<double> D = matrix("distortion_coefficients", 8);
+		if (D.size() != 4 && D.size() != 5 && D.size() != 8)
+			throw std::runtime_error(
+				path + ": 'distortion_coefficients' must have 4, 5 or 8 entries");
+		c.distortion = mrpt::img::DistortionModel::plumb_bob;
+		for (size_t i = 0; i < D.size(); ++i) c.dist[i] = D[i];
+	}
+	return c;
+}
+
+mrpt::img::TCamera loadRosYaml(const std::string& path)
+{
+	mrpt::containers::yaml y = parseYaml(path, fileText(path));
 	for (const char* key : {"image_width", "image_height", "camera_matrix"})
 		if (!y.has(key))
 			throw std::runtime_error(path + ": missing required key '" + std::string(key) + "'");
