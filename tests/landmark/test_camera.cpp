@@ -132,15 +132,21 @@ TEST(Camera, LoadsOpenCvYaml)
 {
 	const auto p = writeTemp(
 		"cam_cv.yaml",
-		"%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  "
+		"%YAML:1.0\n---\ncalibration_time: \"Sat 05 Dec 2026\"\nimage_points: !!opencv-nd-matrix\n"
+		"  sizes: [ 2, 1 ]\n  dt: \"2f\"\n  data: [ 1., 2., 3., 4. ]\n"
+		"image_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n  "
 		"rows: 3\n  cols: 3\n  dt: d\n  data: [ 810., 0., 320.,\n        0., 805., 240.,\n     0., "
 		"0., 1. ]\n# a comment\ndistortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  "
 		"dt: d\n  data: [ -0.2, 0.03, 0., 0., 0. ]\n");
-	// The data's continuation lines sit at any indentation inside '[ ]'.
+	// The data's continuation lines sit at any indentation inside '[ ]';
+	// the other keys OpenCV's calibration sample writes are ignored.
 	const CameraModel c = CameraModel::load(p);
 	EXPECT_DOUBLE_EQ(c.fx(), 810);
 	EXPECT_DOUBLE_EQ(c.fy(), 805);
+	EXPECT_DOUBLE_EQ(c.cy(), 240);
+	EXPECT_EQ(c.width(), 640);
 	EXPECT_TRUE(c.hasDistortion());
+	EXPECT_DOUBLE_EQ(c.params().dist[0], -0.2);
 }
 
 TEST(Camera, BadFilesGiveClearErrors)
