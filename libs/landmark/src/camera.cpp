@@ -245,7 +245,7 @@ mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 		if (!m.isMap() || !m.has("data"))
 			throw std::runtime_error(
 				path + ": '" + key + "' is not an !!opencv-matrix with 'data'");
-		const std::vector<double> data = yamlNumbers(m["data"], std::string(key) + ".data", path);
+		std::vector<double> data = yamlNumbers(m["data"], std::string(key) + ".data", path);
 		if (m.has("rows") && m.has("cols"))
 		{
 			const auto r = yamlNumbers(m["rows"], std::string(key) + ".rows", path);
