@@ -57,14 +57,14 @@ void addWarning(std::vector<std::string>* warnings, const std::string& w)
 		std::cerr << "warning: " << w << "\n";
 }
 
-bool startsWithOpenCvYaml(const std::string& path)
+/** OpenCV's YAML (cv::FileStorage's "%YAML:" first line, or its matrix
+ * tag below it) rather than ROS's, from the file's \a text. */
+bool isOpenCvYaml(const std::string& text)
 {
-	std::ifstream f(path);
-	std::string first;
-	std::getline(f, first);
-	std::stringstream all;
-	all << f.rdbuf();
-	return first.rfind("%YAML:", 0) == 0 || all.str().find("!!opencv-matrix") != std::string::npos;
+	const auto first_end = text.find('\n');
+	return text.rfind("%YAML:", 0) == 0 ||
+		   (first_end != std::string::npos &&
+			text.find("!!opencv-matrix", first_end + 1) != std::string::npos);
 }
 
 /** Runs \a f with the process' stderr (file descriptor 2) sent to a
@@ -109,37 +109,41 @@ std::string capturingStderr(F&& f)
 	return captured;
 }
 
-/** Every scalar of a YAML number field as text is a finite number. */
-void requireYamlNumbers(
+/** The finite numbers of the YAML number field \a node (a scalar or a
+ * list of scalars); throws naming \a what where it holds anything else. */
+std::vector<double> yamlNumbers(
 	const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
 {
-	std::vector<std::string> values;
-	auto text = [&](const auto& scalar)
+	std::vector<double> values;
+	auto add = [&](const auto& scalar)
 	{
+		std::string text;
 		try
 		{
-			values.push_back(scalar.template as<std::string>());
+			text = scalar.template as<std::string>();
 		}
 		catch (const std::exception&)
 		{
-			// Not stored as text (cannot happen for a parsed file): MRPT checks it.
+			return;	 // not stored as text (cannot happen for a parsed file): MRPT checks it
 		}
+		const auto v = parseFiniteNumber(text);
+		if (!v)
+			throw std::runtime_error(
+				path + ": '" + what + "' holds '" + text + "', not a finite number");
+		values.push_back(*v);
 	};
 	if (node.isSequence())
 		for (const auto& v : node.asSequence())
 		{
 			if (!v.isScalar())
 				throw std::runtime_error(path + ": '" + what + "' must be a list of numbers");
-			text(v);
+			add(v);
 		}
 	else if (node.isScalar())
-		text(node);
+		add(node);
 	else
 		throw std::runtime_error(path + ": '" + what + "' must be a number or a list of numbers");
-	for (const auto& v : values)
-		if (!parseFiniteNumber(v))
-			throw std::runtime_error(
-				path + ": '" + what + "' holds '" + v + "', not a finite number");
+	return values;
 }
 
 /** Refuses what no camera YAML holds but makes libfyaml (0.8, Debian
@@ -210,21 +214,6 @@ mrpt::containers::yaml parseYaml(const std::string& path, const std::string& tex
 	return y;
 }
 
-/** The finite numbers of the YAML sequence (or scalar) \a node. */
-std::vector<double> yamlNumbers(
-	const mrpt::containers::yaml& node, const std::string& what, const std::string& path)
-{
-	requireYamlNumbers(node, what, path);
-	std::vector<double> values;
-	auto add = [&](const auto& scalar)
-	{ values.push_back(*parseFiniteNumber(scalar.template as<std::string>())); };
-	if (node.isSequence())
-		for (const auto& v : node.asSequence()) add(v);
-	else
-		add(node);
-	return values;
-}
-
 /** OpenCV's camera YAML (cv::FileStorage, as OpenCV's calibration sample
  * writes it): image_width, image_height, camera_matrix and
  * distortion_coefficients as !!opencv-matrix maps (rows, cols, dt, data).
@@ -233,9 +222,8 @@ std::vector<double> yamlNumbers(
  * fuzzing), and one reader guarded against its failures serves both
  * formats. Its "%YAML:1.0" first line is OpenCV's own spelling of a
  * directive; it is blanked, keeping the line numbers. */
-mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
+mrpt::img::TCamera loadOpenCvYaml(const std::string& path, std::string text)
 {
-	std::string text = fileText(path);
 	if (text.rfind("%YAML:", 0) == 0) text.erase(0, text.find_first_of("\r\n"));
 	const mrpt::containers::yaml y = parseYaml(path, text);
 	if (!y.isMap()) throw std::runtime_error(path + ": expected a YAML map of camera keys");
@@ -288,23 +276,22 @@ mrpt::img::TCamera loadOpenCvYaml(const std::string& path)
 	return c;
 }
 
-mrpt::img::TCamera loadRosYaml(const std::string& path)
+mrpt::img::TCamera loadRosYaml(const std::string& path, const std::string& text)
 {
-	mrpt::containers::yaml y = parseYaml(path, fileText(path));
+	mrpt::containers::yaml y = parseYaml(path, text);
 	for (const char* key : {"image_width", "image_height", "camera_matrix"})
 		if (!y.has(key))
 			throw std::runtime_error(path + ": missing required key '" + std::string(key) + "'");
-	requireYamlNumbers(y["image_width"], "image_width", path);
-	requireYamlNumbers(y["image_height"], "image_height", path);
+	yamlNumbers(y["image_width"], "image_width", path);
+	yamlNumbers(y["image_height"], "image_height", path);
 	if (!y["camera_matrix"].isMap() || !y["camera_matrix"].has("data"))
 		throw std::runtime_error(path + ": 'camera_matrix' needs 'data: [9 numbers]'");
-	requireYamlNumbers(y["camera_matrix"]["data"], "camera_matrix.data", path);
+	yamlNumbers(y["camera_matrix"]["data"], "camera_matrix.data", path);
 	if (y["camera_matrix"]["data"].asSequence().size() != 9)
 		throw std::runtime_error(path + ": 'camera_matrix.data' must hold 9 numbers");
 	if (y.has("distortion_coefficients") && y["distortion_coefficients"].isMap() &&
 		y["distortion_coefficients"].has("data"))
-		requireYamlNumbers(
-			y["distortion_coefficients"]["data"], "distortion_coefficients.data", path);
+		yamlNumbers(y["distortion_coefficients"]["data"], "distortion_coefficients.data", path);
 	if (!y.has("camera_name")) y["camera_name"] = std::string("camera");
 	if (!y.has("distortion_coefficients"))
 	{
@@ -396,7 +383,10 @@ CameraModel CameraModel::load(
 	const std::string ext = lowerExtension(path);
 	mrpt::img::TCamera c;
 	if (ext == "yaml" || ext == "yml")
-		c = startsWithOpenCvYaml(path) ? loadOpenCvYaml(path) : loadRosYaml(path);
+	{
+		std::string text = fileText(path);
+		c = isOpenCvYaml(text) ? loadOpenCvYaml(path, std::move(text)) : loadRosYaml(path, text);
+	}
 	else
 		c = loadIni(path, section, warnings);
 	validateCamera(c, path);
