@@ -104,8 +104,8 @@ Errors locatorErrors(
 // moves towards that channel's dark side: G's towards the black frame (the
 // square looks larger), R + B's into the fill (a clipped fill's locator
 // reads R + B only within reach of G's peak, G's peak beyond). That bend is
-// what the frame's midline (centreOnFrame()) cancels and no single-edge
-// locator can.
+// what the green band's midline (centreOnBand()) cancels and no
+// single-edge locator can.
 TEST(EdgeModels, EveryLocatorThroughCurvesBlurAndSharpening)
 {
 	const SubpixelParams p;

@@ -48,15 +48,13 @@ std::string label(const char* name, double v, uint64_t seed)
 	s << name << "=" << v << " seed=" << seed;
 	return s.str();
 }
-/** The sub-pixel stage's models with the frame's midline off: the clip's tests
- * below are of the single-edge models, in linear light, where they are
- * exact. A fill and a sheet clipped by different amounts narrow the frame
- * too, and the midline (which assumes both edges bend alike) would take
- * those sides over. */
+/** The sub-pixel stage's models with the green band's midline off: the
+ * clip's tests below are of the single-edge models, in linear light, where
+ * they are exact. */
 SubpixelModels singleEdgeModels()
 {
 	SubpixelModels m;
-	m.frame_midline = false;
+	m.band_midline = false;
 	return m;
 }
 
@@ -562,10 +560,10 @@ TEST(Renders, GreyOnlyImageGivesNothing)
 // black frame towards the black: read alone, the inner edge moves outwards
 // and the square looks larger, by a few tenths of a pixel through sRGB,
 // gamma and a phone's filmic curve, with sharpening and JPEG after them.
-// The frame's midline (SubpixelModels::frame_midline) cancels the bend:
+// The green band's midline (SubpixelModels::band_midline) cancels the bend:
 // each edge's mean outward shift, with and without it, near and far,
 // squarely and at 30 deg.
-TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
+TEST(Renders, BandMidlineUndoesTheTransferCurvesBend)
 {
 	using sim::Transfer;
 	for (const Transfer curve : {Transfer::SRGB, Transfer::Gamma, Transfer::Filmic})
@@ -587,7 +585,7 @@ TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
 					for (const bool midline : {false, true})
 					{
 						SubpixelModels models;
-						models.frame_midline = midline;
+						models.band_midline = midline;
 						grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
 					}
 				}
@@ -597,9 +595,6 @@ TEST(Renders, FrameMidlineUndoesTheTransferCurvesBend)
 				 << without << " px outwards read alone, " << with << " px on the midline";
 			std::printf("[ bend ] %s\n", what.str().c_str());
 			SCOPED_TRACE(what.str());
-			// At 2 m the quiet margin is 2 px wide: the outer edge's bright
-			// side is a bar the blur does not let reach the sheet's level,
-			// and bends less than the inner edge.
 			EXPECT_GT(without, 0.2);
 			EXPECT_LT(std::abs(with), dist <= 1 ? 0.05 : 0.1);
 			EXPECT_LT(std::abs(with), 0.3 * without);
@@ -624,10 +619,10 @@ Eigen::Vector4d truthP(const std::string& path)
 // The same on an independent renderer: the committed POV-Ray frames of the
 // camera set (one a light and print group, 0.8-1.5 m), through each
 // transfer curve after a 0.6 px optical blur, with sharpening and JPEG. The
-// midline takes the size bias of every encoded curve down, and leaves
-// linear light as its single-edge models read it (each edge's mean outward
-// shift over the six frames).
-TEST(Renders, FrameMidlineOnCommittedPovrayFrames)
+// band's midline takes the size bias of every encoded curve away, and
+// leaves linear light as its single-edge models read it, up to the band's
+// own scatter (each edge's mean outward shift over the six frames).
+TEST(Renders, BandMidlineOnCommittedPovrayFrames)
 {
 	using sim::Transfer;
 	const std::string dir = std::string(CODEMARK_TEST_DATA_DIR) + "/povray/set";
@@ -655,7 +650,7 @@ TEST(Renders, FrameMidlineOnCommittedPovrayFrames)
 			{
 				SCOPED_TRACE(g);
 				SubpixelModels models;
-				models.frame_midline = midline;
+				models.band_midline = midline;
 				grow[midline] += edgeGrowth(image, camera, models, P);
 			}
 			++n;
@@ -668,17 +663,14 @@ TEST(Renders, FrameMidlineOnCommittedPovrayFrames)
 		SCOPED_TRACE(what.str());
 		if (curve == Transfer::Linear)
 		{
-			EXPECT_LT(std::abs(with - without), 0.01);
+			EXPECT_LT(std::abs(with - without), 0.03);
 			EXPECT_LT(std::abs(with), 0.05);
 		}
 		else
 		{
-			// Half of the bend or more goes: at this blur the bend is near
-			// the stage's threshold (0.1 px on every side), and a landmark
-			// one of whose sides reads less keeps its single-edge lines.
 			EXPECT_GT(without, 0.15);
-			EXPECT_LT(std::abs(with), 0.1);
-			EXPECT_LT(std::abs(with), 0.6 * without);
+			EXPECT_LT(std::abs(with), 0.05);
+			EXPECT_LT(std::abs(with), 0.3 * without);
 		}
 	}
 }

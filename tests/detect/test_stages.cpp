@@ -27,16 +27,21 @@ const cv::Scalar kBlack(25, 25, 25), kGreen(0, 255, 0), kWhite(235, 235, 235);
  * o + 9.5 and o + 89.5; cells of 15 px. */
 cv::Mat craftedLandmark(int id, int o = 40, double blur = 0.8, int size = 180)
 {
-	cv::Mat img(size, size, CV_8UC3, kWhite);
-	cv::rectangle(img, cv::Rect(o, o, 100, 100), kBlack, cv::FILLED);
-	cv::rectangle(img, cv::Rect(o + 10, o + 10, 80, 80), kGreen, cv::FILLED);
+	// Drawn twice as fine and averaged over each pixel: the board's cells
+	// start half-way into a pixel.
+	cv::Mat fine(2 * size, 2 * size, CV_8UC3, kWhite);
+	cv::rectangle(fine, cv::Rect(2 * o, 2 * o, 200, 200), kBlack, cv::FILLED);
+	cv::rectangle(fine, cv::Rect(2 * o + 20, 2 * o + 20, 160, 160), kGreen, cv::FILLED);
 	const CodeCells cells = encodeId(id);
 	// Board: 45 px centred in the 80 px fill: cells start at o + 10 + 17.5.
 	for (int r = 0; r < 3; ++r)
 		for (int c = 0; c < 3; ++c)
 			if (cells[r][c])
 				cv::rectangle(
-					img, cv::Rect(o + 28 + 15 * c, o + 28 + 15 * r, 15, 15), kBlack, cv::FILLED);
+					fine, cv::Rect(2 * o + 55 + 30 * c, 2 * o + 55 + 30 * r, 30, 30), kBlack,
+					cv::FILLED);
+	cv::Mat img;
+	cv::resize(fine, img, cv::Size(size, size), 0, 0, cv::INTER_AREA);
 	if (blur > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), blur);
 	return img;
 }
@@ -305,7 +310,7 @@ TEST(Components, CentreEvidence)
 		findCandidates(segmentColour(lm, SegmentationParams()), 2, lm, ComponentParams()).size(),
 		1u);
 	cv::Mat solid = craftedLandmark(0, 40, 0);
-	cv::rectangle(solid, cv::Rect(40 + 28 + 15, 40 + 28 + 15, 15, 15), kGreen, cv::FILLED);
+	cv::rectangle(solid, cv::Rect(40 + 27 + 15, 40 + 27 + 15, 16, 16), kGreen, cv::FILLED);
 	cv::GaussianBlur(solid, solid, cv::Size(0, 0), 0.8);
 	const cv::Mat m = segmentColour(solid, SegmentationParams());
 	EXPECT_TRUE(findCandidates(m, 2, solid, ComponentParams()).empty());
@@ -1134,7 +1139,7 @@ TEST(Code, AmbiguousCellIsRejected)
 	q.corners_raw = q.corners_ideal = craftedCorners();
 	cv::Mat img = craftedLandmark(0);
 	// Cell (0, 0) halfway between black and green.
-	cv::rectangle(img, cv::Rect(40 + 28, 40 + 28, 15, 15), cv::Scalar(0, 140, 0), cv::FILLED);
+	cv::rectangle(img, cv::Rect(40 + 27, 40 + 27, 16, 16), cv::Scalar(0, 140, 0), cv::FILLED);
 	EXPECT_FALSE(readCode(img, q, CameraModel(), g, CodeParams()));
 }
 

@@ -96,10 +96,8 @@ DetectionResult detectWithModels(
 			bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio, models);
 		tm.subpixel_us += microsSince(t);
 		if (!refined) continue;
-		if (models.frame_midline)
-			centreOnFrame(
-				bgr, *refined, camera, thr, frame_ratio, geometry.margin_m / geometry.inner_size_m,
-				opt.subpixel);
+		if (models.band_midline)
+			centreOnBand(bgr, *refined, camera, thr, frame_ratio, fill_ratio, opt.subpixel);
 		tm.subpixel_us += microsSince(t);
 		++res.counts.fitted;
 

@@ -179,8 +179,8 @@ struct SubpixelModels
 	bool outer_edge = true;
 	/** Shift thin sides by their print model's offset (thinFrameOffset()). */
 	bool thin_frame = true;
-	/** Stage 7b: centreOnFrame(). */
-	bool frame_midline = true;
+	/** Stage 7b: centreOnBand(). */
+	bool band_midline = true;
 	/** The Peak locator's step model (EdgeMode::Peak rather than
 	 * EdgeMode::PeakGaussian). */
 	bool step_peak = true;
@@ -469,65 +469,17 @@ std::optional<Eigen::Vector2d> cornerOfSides(const std::array<LineFit, 4>& sides
  * pixels; false where neighbouring sides are parallel. */
 bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
 
-/** A side's line on the frame's midline and the median shift of its edges
- * [px, positive inwards]. */
-struct FrameMidline
-{
-	LineFit line;
-	double shift_px = 0;
-};
-
-/** One profile across a side's black frame (readFrameSide()). */
-struct FrameReading
-{
-	int s, base;  //!< along coordinate; across coordinate of sample 0 [px]
-	/** The inner and outer edges [samples from base, into the fill] and
-	 * the frame's width the reading's square predicted [px]. */
-	double e_in, e_out, width;
-	int dark, fill, sheet;	//!< G of the frame, the fill and the sheet
-	double blur_var;  //!< the inner edge's blur variance [px^2]
-};
-
-/** A side's frame as readFrameSide() reads it. */
-struct FrameSide
-{
-	int side = 0, along = 1, inward = 1;
-	std::vector<FrameReading> reads;  //!< ordered along
-};
-
-/** Side \a side's black frame read across, in at most about \a
- * max_profiles profiles evenly spread along it (an odd stride, the first
- * \a offset strides from the side's start): per profile the inner and the
- * outer edge of the frame (the same locator, mirrored) and the levels next
- * to them. Nullopt where the quiet margin is unresolved (\a margin_ratio:
- * its width over the inner side) or no profile reads both edges. */
-std::optional<FrameSide> readFrameSide(
-	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
-	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles,
-	double offset = 0);
-
-/** The side's line on the frame's midline, the frame's width at each
- * reading from \a q's homography: the missing width shared between the
- * edges in the ratio of their bends (the square roots of their contrasts),
- * the inner edge moved inwards by its share. */
-std::optional<FrameMidline> midlineOfSide(
-	const FrameSide& f, const RefinedQuad& q, const CameraModel& camera, double frame_ratio,
-	const SubpixelParams& p);
-
-/** readFrameSide() and midlineOfSide() on the same square. */
-std::optional<FrameMidline> frameMidlineSide(
-	const cv::Mat& bgr, const RefinedQuad& q, int side, const CameraModel& camera, double min_rise,
-	double frame_ratio, double margin_ratio, const SubpixelParams& p, int max_profiles);
-
-/** Stage 7b: where frameMidlineSide()'s shift is at least 0.1 px inwards
- * on every side it reads (the frame reads narrower than the homography's
- * width all round: a transfer curve or a clip bent its edges), each side
- * goes to the frame's midline, twice (the second time with the frame's
- * widths from the first's square, on the same readings), and the corners
- * follow; otherwise \a q stays as it is. */
-void centreOnFrame(
+/** Stage 7b: each side's line moved onto the inner edge that the green
+ * band's midline gives (the band between the frame's inner edge and a
+ * black code cell, or the centre cell behind a green middle cell: two
+ * mirror-image edges of one ink and one fill, which a camera's response
+ * moves alike), the median over the side's profiles; the corners follow.
+ * Only where the bands' width differs from the printed one beyond its
+ * scatter (a bend: a transfer curve, a clip, dot gain); otherwise \a q
+ * stays as it is. \a fill_ratio: the band's width over the inner side. */
+void centreOnBand(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
-	double frame_ratio, double margin_ratio, const SubpixelParams& p);
+	double frame_ratio, double fill_ratio, const SubpixelParams& p);
 
 // ------------------------------------------------------------------ stage 8
 /** The code of one landmark. */
