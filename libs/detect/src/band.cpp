@@ -59,6 +59,13 @@ EdgeMode bandLocator(double frame_px, const SubpixelParams& p)
 	return frame_px >= p.min_frame_px_centroid ? EdgeMode::Centroid : EdgeMode::Peak;
 }
 
+/** The median of \a x (reordered; not empty). */
+double medianOf(std::vector<double>& x)
+{
+	std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+	return x[x.size() / 2];
+}
+
 /** Whether the bands read wider or narrower than printed beyond their
  * own scatter: \a excess holds each profile's measured minus predicted
  * band width [px]; its median must lie at least kMinZ of its standard
@@ -72,14 +79,12 @@ bool bandsShowBend(std::vector<double> excess)
 {
 	const size_t n = excess.size();
 	if (static_cast<int>(n) < kMinProfiles) return false;
-	std::nth_element(excess.begin(), excess.begin() + n / 2, excess.end());
-	const double median = excess[n / 2];
+	const double median = medianOf(excess);
 	std::vector<double> dev(n);
 	for (size_t i = 0; i < n; ++i) dev[i] = std::abs(excess[i] - median);
-	std::nth_element(dev.begin(), dev.begin() + n / 2, dev.end());
 	// A normal sample's sigma is 1.4826 MADs; its median's standard error
 	// sqrt(pi / 2) sigma / sqrt(n).
-	const double se = 1.4826 * dev[n / 2] * std::sqrt(M_PI / 2 / n);
+	const double se = 1.4826 * medianOf(dev) * std::sqrt(M_PI / 2 / n);
 	return std::abs(median) >= kMinZ * se;
 }
 
@@ -94,10 +99,7 @@ std::optional<double> acrossOn(
 	const double t = (s - a0) / (a1 - a0);
 	return p0(across) + t * (p1(across) - p0(across));
 }
-}  // namespace
 
-namespace
-{
 /** One pass of centreOnBand() on \a q's square; false (and \a q as it
  * is) where no corners follow, or, when \a decide, where the bands show
  * no bend (bandsShowBend()). */
@@ -112,6 +114,11 @@ bool centreOnBandOnce(
 	RefinedQuad next = q;
 	std::vector<double> residuals, excess;
 	std::vector<int> v, vr;
+	const auto g_at = [&](const Eigen::Vector2d& f)
+	{
+		const Eigen::Vector2d px = map(f);
+		return sampleG(bgr, px.x(), px.y());
+	};
 	for (int side = 0; side < 4; ++side)
 	{
 		const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
@@ -128,11 +135,6 @@ bool centreOnBandOnce(
 			const Eigen::Vector2d mid = 0.5 * (fa + fb);
 			// Face units are half the side: a depth d (fraction of the side)
 			// is 2 d inwards.
-			const auto g_at = [&](const Eigen::Vector2d& f)
-			{
-				const Eigen::Vector2d px = map(f);
-				return sampleG(bgr, px.x(), px.y());
-			};
 			const auto g_cell = g_at(mid - out * 2 * (fill_ratio + 0.5 * cell)),
 					   g_band = g_at(mid - out * fill_ratio),
 					   g_frame = g_at(mid + out * frame_ratio);
@@ -159,7 +161,8 @@ bool centreOnBandOnce(
 				if (!c_in || !c_cell) continue;
 				const int inward = *c_cell > *c_in ? 1 : -1;
 				const double width = inward * (*c_cell - *c_in);
-				if (width * frame_ratio / depth < kMinFramePx) continue;
+				const double frame_px = width * frame_ratio / depth;
+				if (frame_px < kMinFramePx) continue;
 				const int base = static_cast<int>(std::lround(*c_in)) - inward * (kReach + kSearch);
 				const int n = static_cast<int>(std::ceil(width)) + 2 * (kReach + kSearch) + 1;
 				const int c_first = std::min(base, base + inward * (n - 1)),
@@ -180,8 +183,7 @@ bool centreOnBandOnce(
 				// far edge, a few pixels away on a small landmark, pulls the
 				// derivative's peak away from it, more from the narrower
 				// frame: the peak locator removes a model of that lobe.
-				const double frame_px = width * frame_ratio / depth,
-							 cell_px = next_green ? width * cell / depth : 0;
+				const double cell_px = next_green ? width * cell / depth : 0;
 				const EdgeMode mode = bandLocator(frame_px, p);
 				const auto e_in = locateRisingEdge(
 					v.data(), n, std::max(1, ki - kSearch), std::min(n - 2, ki + kSearch), min_rise,
@@ -206,9 +208,7 @@ bool centreOnBandOnce(
 			}
 		}
 		if (static_cast<int>(residuals.size()) < kMinProfiles) continue;
-		std::nth_element(
-			residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
-		const double move = residuals[residuals.size() / 2];
+		const double move = medianOf(residuals);
 		if (std::abs(move) <= kMaxMovePx) next.sides[side].c -= move;
 	}
 	if (decide && !bandsShowBend(excess)) return false;
