@@ -53,6 +53,8 @@ struct Sample
 	Eigen::Vector4d e_P;
 	std::array<bool, 4> clipped{};	// DetectionQuality::fill_clipped (top, right, bottom, left)
 	std::array<double, 4> line_rms{};  // DetectionQuality::line_rms_px
+	std::array<int, 4> line_support{};	// DetectionQuality::line_support
+	double code_margin = 0;	 // DetectionQuality::code_margin
 	/** PoseOptions::aligned_edge_ratio's weight of the top and bottom edges:
 	 * 1 - the rows between their ends (true corners), 0 beyond one row. */
 	double aligned_weight = 0;
@@ -320,6 +322,8 @@ int main(int argc, char** argv)
 							primaryMeasurement(dl.detection.corners, scene.camera) - img.truth[0].P;
 						s.clipped = dl.detection.quality.fill_clipped;
 						s.line_rms = dl.detection.quality.line_rms_px;
+						s.line_support = dl.detection.quality.line_support;
+						s.code_margin = dl.detection.quality.code_margin;
 						s.image_noise = dl.detection.quality.image_noise_grey;
 						s.group = i % 12;
 						const auto& tc = img.truth[0].corners_px;
@@ -343,7 +347,8 @@ int main(int argc, char** argv)
 			std::ofstream f(csv_arg.getValue());
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
 				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
-				 "clipped_left,rms_top,rms_right,rms_bottom,rms_left,image_noise,group\n";
+				 "clipped_left,rms_top,rms_right,rms_bottom,rms_left,image_noise,group,support_top,"
+				 "support_right,support_bottom,support_left,code_margin\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
@@ -351,7 +356,9 @@ int main(int argc, char** argv)
 				for (int k = 0; k < 4; ++k) f << "," << s.e_P[k];
 				for (int k = 0; k < 4; ++k) f << "," << int(s.clipped[k]);
 				for (int k = 0; k < 4; ++k) f << "," << s.line_rms[k];
-				f << "," << s.image_noise << "," << s.group << "\n";
+				f << "," << s.image_noise << "," << s.group;
+				for (int k = 0; k < 4; ++k) f << "," << s.line_support[k];
+				f << "," << s.code_margin << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
