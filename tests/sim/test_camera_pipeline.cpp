@@ -301,6 +301,73 @@ TEST(CameraPipeline, JpegIsFourTwoZero)
 	EXPECT_EQ(back.type(), CV_8UC3);
 }
 
+TEST(CameraPipeline, ChromaSubsamplingKeepsLumaAndAveragesColour)
+{
+	// Stripes of two colours one pixel wide, along columns (vertical
+	// stripes) and along rows (horizontal ones); saturations low enough that
+	// no averaged colour leaves the gamut.
+	const cv::Vec3b a(100, 120, 160), b(150, 140, 95);
+	cv::Mat cols(16, 16, CV_8UC3), rows(16, 16, CV_8UC3);
+	for (int v = 0; v < 16; ++v)
+		for (int u = 0; u < 16; ++u)
+		{
+			cols.at<cv::Vec3b>(v, u) = u % 2 ? b : a;
+			rows.at<cv::Vec3b>(v, u) = v % 2 ? b : a;
+		}
+	const auto ycc = [](const cv::Mat& bgr)
+	{
+		cv::Mat f, out;
+		bgr.convertTo(f, CV_32FC3);
+		cv::cvtColor(f, out, cv::COLOR_BGR2YCrCb);
+		return out;
+	};
+	const cv::Vec3f mean = 0.5f * (ycc(cols).at<cv::Vec3f>(0, 0) + ycc(cols).at<cv::Vec3f>(0, 1));
+	// Interior pixels: luma kept, chroma the stripes' mean where the
+	// subsampling spans them, kept where it does not.
+	const auto check = [&](const cv::Mat& in, ChromaSubsampling s, bool averaged)
+	{
+		const cv::Mat x = ycc(in), y = ycc(subsampleChroma(in, s));
+		for (int v = 2; v < 14; ++v)
+			for (int u = 2; u < 14; ++u)
+			{
+				const cv::Vec3f p = x.at<cv::Vec3f>(v, u), q = y.at<cv::Vec3f>(v, u);
+				EXPECT_NEAR(q[0], p[0], 1.5) << chromaName(s) << " at " << u << "," << v;
+				for (int c = 1; c < 3; ++c)
+					EXPECT_NEAR(q[c], averaged ? mean[c] : p[c], 2.0)
+						<< chromaName(s) << " plane " << c << " at " << u << "," << v;
+			}
+	};
+	check(cols, ChromaSubsampling::S422, true);
+	check(rows, ChromaSubsampling::S422, false);
+	check(cols, ChromaSubsampling::S420, true);
+	check(rows, ChromaSubsampling::S420, true);
+	EXPECT_EQ(cv::norm(subsampleChroma(cols, ChromaSubsampling::None), cols, cv::NORM_INF), 0);
+	// The stripes' colours differ by far more than the tolerance.
+	EXPECT_GT(std::abs(ycc(cols).at<cv::Vec3f>(0, 0)[1] - mean[1]), 10);
+}
+
+TEST(CameraPipeline, ChromaSubsamplingKey)
+{
+	const RenderOptions o = loadRender("chroma_subsampling = 420\n");
+	EXPECT_EQ(o.chroma_subsampling, ChromaSubsampling::S420);
+	EXPECT_TRUE(o.hasCameraStages());
+	EXPECT_EQ(loadRender("preset = webcam\n").chroma_subsampling, ChromaSubsampling::None);
+	const RenderOptions any = loadRender("chroma_subsampling = any\n");
+	mrpt::config::CConfigFileMemory c;
+	any.saveToConfigFile(c, "render");
+	RenderOptions back;
+	back.loadFromConfigFile(c, "render");
+	std::set<ChromaSubsampling> seen;
+	for (uint64_t s = 0; s < 30; ++s)
+	{
+		seen.insert(any.drawn(s).chroma_subsampling);
+		EXPECT_EQ(any.drawn(s).chroma_subsampling, back.drawn(s).chroma_subsampling);
+	}
+	EXPECT_EQ(seen.size(), 3u);
+	EXPECT_NE(
+		loadError("chroma_subsampling = 411\n").find("chroma_subsampling"), std::string::npos);
+}
+
 TEST(CameraPipeline, DefaultsLeaveTheLinearImageAsItIs)
 {
 	cv::Mat img(10, 10, CV_32FC3);

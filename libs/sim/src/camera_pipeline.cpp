@@ -154,6 +154,20 @@ const char* transferName(Transfer t)
 	return "linear";
 }
 
+const char* chromaName(ChromaSubsampling c)
+{
+	switch (c)
+	{
+		case ChromaSubsampling::S422:
+			return "422";
+		case ChromaSubsampling::S420:
+			return "420";
+		case ChromaSubsampling::None:
+			break;
+	}
+	return "none";
+}
+
 BayerLayout bayerFromName(const std::string& name, const std::string& key)
 {
 	return fromName<BayerLayout, 5>(
@@ -174,6 +188,13 @@ Transfer transferFromName(const std::string& name, const std::string& key)
 	return fromName<Transfer, 4>(
 		name, key, {Transfer::Linear, Transfer::SRGB, Transfer::Gamma, Transfer::Filmic},
 		transferName);
+}
+
+ChromaSubsampling chromaFromName(const std::string& name, const std::string& key)
+{
+	return fromName<ChromaSubsampling, 3>(
+		name, key, {ChromaSubsampling::None, ChromaSubsampling::S422, ChromaSubsampling::S420},
+		chromaName);
 }
 
 double encodeTransfer(double x, Transfer t, double gamma, double filmic_strength)
@@ -467,6 +488,41 @@ void unsharpMask(cv::Mat& img, double sigma_px, double amount)
 	cv::addWeighted(img, 1 + amount, blurred, -amount, 0, img);
 }
 
+cv::Mat subsampleChroma(const cv::Mat& bgr8, ChromaSubsampling s)
+{
+	CV_Assert(bgr8.type() == CV_8UC3);
+	if (s == ChromaSubsampling::None) return bgr8.clone();
+	// In floating point scaled to [0, 1] (OpenCV's chroma offset for float
+	// images is 0.5), each plane rounded to 8 bits as the format stores it.
+	const auto round8 = [](cv::Mat& plane)
+	{
+		cv::Mat q;
+		plane.convertTo(q, CV_8U, 255.0);
+		q.convertTo(plane, CV_32F, 1 / 255.0);
+	};
+	cv::Mat f, ycc;
+	bgr8.convertTo(f, CV_32FC3, 1 / 255.0);
+	cv::cvtColor(f, ycc, cv::COLOR_BGR2YCrCb);
+	std::vector<cv::Mat> planes;
+	cv::split(ycc, planes);
+	round8(planes[0]);
+	const double fy = s == ChromaSubsampling::S420 ? 0.5 : 1.0;
+	for (int p = 1; p < 3; ++p)
+	{
+		// cv::resize aligns pixel centres: INTER_AREA averages each cell,
+		// INTER_LINEAR interpolates between the cells' centres.
+		cv::Mat cells;
+		cv::resize(planes[p], cells, cv::Size(), 0.5, fy, cv::INTER_AREA);
+		round8(cells);
+		cv::resize(cells, planes[p], planes[p].size(), 0, 0, cv::INTER_LINEAR);
+	}
+	cv::merge(planes, ycc);
+	cv::cvtColor(ycc, f, cv::COLOR_YCrCb2BGR);
+	cv::Mat out;
+	f.convertTo(out, CV_8UC3, 255.0);
+	return out;
+}
+
 cv::Mat jpegRoundTrip(const cv::Mat& img, int quality)
 {
 	std::vector<uchar> buf;
@@ -510,9 +566,11 @@ cv::Mat cameraImage(cv::Mat& linear, const RenderOptions& o, double cx, double c
 	if (o.bayer != BayerLayout::None) img = demosaicRaw(mosaic(img, o.bayer), o.bayer, o.demosaic);
 	applyTransfer(img, o.transfer, o.gamma, o.filmic_strength);
 	unsharpMask(img, o.unsharp_sigma_px, o.unsharp_amount);
-	// 9-10. Rounding (and clamping) to 8 bits, the codec.
+	// 9-11. Rounding (and clamping) to 8 bits, the video format, the codec.
 	cv::Mat out;
 	img.convertTo(out, CV_8UC3);
+	if (o.chroma_subsampling != ChromaSubsampling::None)
+		out = subsampleChroma(out, o.chroma_subsampling);
 	if (o.jpeg_quality > 0) out = jpegRoundTrip(out, o.jpeg_quality);
 	return out;
 }

@@ -119,6 +119,7 @@ const ChoiceKey kChoices[] = {
 	{"bayer", {"RGGB", "BGGR", "GRBG", "GBRG"}},
 	{"demosaic", {"bilinear", "vng", "edge-aware"}},
 	{"transfer", {"linear", "srgb", "gamma", "filmic"}},
+	{"chroma_subsampling", {"none", "422", "420"}},
 };
 
 void setChoice(RenderOptions& o, const std::string& key, const std::string& name)
@@ -127,6 +128,8 @@ void setChoice(RenderOptions& o, const std::string& key, const std::string& name
 		o.bayer = bayerFromName(name, key);
 	else if (key == "demosaic")
 		o.demosaic = demosaicFromName(name, key);
+	else if (key == "chroma_subsampling")
+		o.chroma_subsampling = chromaFromName(name, key);
 	else
 		o.transfer = transferFromName(name, key);
 }
@@ -135,6 +138,7 @@ std::string choiceName(const RenderOptions& o, const std::string& key)
 {
 	if (key == "bayer") return bayerName(o.bayer);
 	if (key == "demosaic") return demosaicName(o.demosaic);
+	if (key == "chroma_subsampling") return chromaName(o.chroma_subsampling);
 	return transferName(o.transfer);
 }
 
@@ -288,6 +292,7 @@ void RenderOptions::applyPreset(const std::string& name)
 	bayer = d.bayer;
 	demosaic = d.demosaic;
 	transfer = d.transfer;
+	chroma_subsampling = d.chroma_subsampling;
 	range_draws.clear();
 	choice_draws.clear();
 	mrpt::config::CConfigFileMemory mem;
@@ -306,7 +311,8 @@ bool RenderOptions::hasCameraStages() const
 			k.get(*this) != k.get(d))
 			return true;
 	}
-	return bayer != d.bayer || transfer != d.transfer || !range_draws.empty() ||
+	return bayer != d.bayer || transfer != d.transfer ||
+		   chroma_subsampling != d.chroma_subsampling || !range_draws.empty() ||
 		   !choice_draws.empty();
 }
 

@@ -21,7 +21,9 @@
  *  7. the transfer curve (linear, sRGB, pure gamma, filmic S-curve);
  *  8. unsharp masking (unsharp_sigma_px, unsharp_amount);
  *  9. rounding to 8 bits;
- * 10. the JPEG round trip (jpeg_quality, 4:2:0 chroma subsampling).
+ * 10. chroma subsampling of a YCbCr video format (chroma_subsampling:
+ *     4:2:2 or 4:2:0, without compression);
+ * 11. the JPEG round trip (jpeg_quality, 4:2:0 chroma subsampling).
  *
  * The stage functions are public so that each can be tested on its own;
  * cameraImage() runs them all from a RenderOptions.
@@ -68,14 +70,26 @@ enum class Transfer
 	Filmic
 };
 
+/** Chroma subsampling of a YCbCr image format (a webcam's YUYV or NV12
+ * stream): the colour difference planes at half the luma's resolution. */
+enum class ChromaSubsampling
+{
+	None,  //!< 4:4:4: every pixel keeps its colour
+	S422,  //!< 4:2:2: half the columns (YUYV, UYVY)
+	S420  //!< 4:2:0: half the columns and half the rows (NV12, I420, MJPEG)
+};
+
 const char* bayerName(BayerLayout b);  //!< "none", "RGGB", ...
 const char* demosaicName(Demosaic d);  //!< "bilinear", "vng", "edge-aware"
 const char* transferName(Transfer t);  //!< "linear", "srgb", "gamma", "filmic"
+const char* chromaName(ChromaSubsampling c);  //!< "none", "422", "420"
 /** Parsers of the names above (case-insensitive); throw
  * std::invalid_argument naming \a key and the accepted names. */
 BayerLayout bayerFromName(const std::string& name, const std::string& key = "bayer");
 Demosaic demosaicFromName(const std::string& name, const std::string& key = "demosaic");
 Transfer transferFromName(const std::string& name, const std::string& key = "transfer");
+ChromaSubsampling chromaFromName(
+	const std::string& name, const std::string& key = "chroma_subsampling");
 
 /** The encoded value of linear \a x in [0, 1] (clamped) under \a t. */
 double encodeTransfer(double x, Transfer t, double gamma = 2.2, double filmic_strength = 0.25);
@@ -116,6 +130,13 @@ cv::Mat mosaic(const cv::Mat& img, BayerLayout layout);
  * 0..255: quantised to 16 bits (8 bits for VNG, OpenCV's limit) as a
  * raw file is, then cv::demosaicing. */
 cv::Mat demosaicRaw(const cv::Mat& raw, BayerLayout layout, Demosaic method);
+
+/** An 8-bit BGR image through a YCbCr format with subsampled chroma and
+ * back: converted to full-range YCbCr (BT.601, as JPEG), Cb and Cr
+ * averaged over 2 x 1 (4:2:2) or 2 x 2 (4:2:0) pixel cells and
+ * interpolated back linearly between the cells' centres (a decoder's
+ * upsampling), then to BGR; Y is kept at full resolution. None: a copy. */
+cv::Mat subsampleChroma(const cv::Mat& bgr8, ChromaSubsampling s);
 
 /** A print across its edges in one dimension, in linear light: levels[0]
  * (B, G, R) [0..1 of full scale, above 1 clips] up to edges[0] [px],

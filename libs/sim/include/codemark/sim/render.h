@@ -89,6 +89,9 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	double filmic_strength = 0.25;	//!< strength of Transfer::Filmic's S-curve [0..0.9]
 	double unsharp_sigma_px = 1.0;	//!< unsharp mask radius [px]
 	double unsharp_amount = 0;	//!< unsharp mask amount; 0 = no sharpening
+	/** Chroma subsampling of the delivered 8-bit image, before any JPEG
+	 * (which subsamples 4:2:0 on its own). */
+	ChromaSubsampling chroma_subsampling = ChromaSubsampling::None;
 	/** @} */
 
 	/** A numeric key drawn per frame, uniformly in [lo, hi]. */
@@ -97,7 +100,7 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 		std::string key;
 		double lo = 0, hi = 0;
 	};
-	/** A named choice (bayer, demosaic, transfer) drawn per frame among
+	/** A named choice (bayer, demosaic, transfer, chroma_subsampling) drawn per frame among
 	 * \a names, each equally likely. */
 	struct ChoiceDraw
 	{
@@ -159,8 +162,8 @@ struct RenderOptions : public mrpt::config::CLoadableOptions
 	 * Flat, Textured or Cluttered; colours as "B G R"), then validate().
 	 * A `preset` key is applied first, so the section's other keys override
 	 * it. The camera pipeline's numeric keys, blur_sigma_px, noise_sigma and
-	 * jpeg_quality also take "lo hi" (drawn per frame); bayer, demosaic and
-	 * transfer take several names or `any`. An unknown name or a value out
+	 * jpeg_quality also take "lo hi" (drawn per frame); bayer, demosaic,
+	 * transfer and chroma_subsampling take several names or `any`. An unknown name or a value out
 	 * of its range throws std::invalid_argument naming the key. */
 	void loadFromConfigFile(
 		const mrpt::config::CConfigFileBase& source, const std::string& section) override;
