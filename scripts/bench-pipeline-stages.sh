@@ -59,6 +59,8 @@ rows=(
 	"unsharp09|+ unsharp sigma 1.0, amount 0.9|$sensor;unsharp_sigma_px = 1.0;unsharp_amount = 0.9"
 	"jpeg85|+ JPEG 85|$sensor;jpeg_quality = 85"
 	"jpeg75|+ JPEG 75|$sensor;jpeg_quality = 75"
+	"chroma422|+ chroma 4:2:2, uncompressed (YUYV)|$sensor;chroma_subsampling = 422"
+	"chroma420|+ chroma 4:2:0, uncompressed (NV12)|$sensor;chroma_subsampling = 420"
 	"webcam|webcam (every stage)|preset = webcam"
 	"webcam-bayer|webcam without the mosaic|preset = webcam;bayer = none"
 	"webcam-srgb|webcam with linear transfer|preset = webcam;transfer = linear"
