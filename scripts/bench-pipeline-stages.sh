@@ -2,7 +2,7 @@
 # Which camera stage costs the detector how much accuracy: the error of the
 # primary measurement P = [x1 y1 x2 y2] (codemark-bench-pose-calib's
 # per-detection CSV: detected against the renderer's exact P) per apparent
-# width of the reference square, on the project's renderer's textured wall
+# width of the reference square and per print, on the project's renderer's textured wall
 # with the prints and lights varied (--realistic --vary-scene), through
 #  - "sensor": the linear preset with the webcam's sensor (full well 8000 e-,
 #    read noise 6 e-), the peer of every other row;
@@ -113,6 +113,8 @@ done
 	echo "half-length), against the renderer's exact P [px], per apparent width of"
 	echo "the reference square; \"x 25-80 px\" is that error over the widths 25-80 px"
 	echo "as a ratio to the sensor row's (the peer in this run)."
+	echo
+	echo "## Per apparent width"
 	echo
 	python3 "$ROOT/scripts/pipeline-stages-table.py" "$WORK" "${table_args[@]}"
 } >"$DOC.tmp"

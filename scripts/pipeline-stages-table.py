@@ -13,6 +13,8 @@ import sys
 
 BINS = [(0, 25), (25, 35), (35, 50), (50, 80), (80, math.inf)]
 PEER_BIN = (25, 80)
+# The prints codemark-bench-pose-calib --vary-scene cycles, in its order.
+PRINTS = ["fluorescent", "inkjet", "laser"]
 
 
 def rms(values):
@@ -67,6 +69,30 @@ def main():
     print()
     print("Cells: RMS error of x / of y [px] (detections in the bin). Detected: of the")
     print("renders where the landmark is fully visible.")
+    print()
+    print("## Per print")
+    print()
+    print("RMS error of x [px] over the widths 25-80 px per print (the CSV's group")
+    print("modulo 3, as codemark-bench-pose-calib --vary-scene cycles them; every")
+    print("light in each), as a ratio to the sensor row's for the same print:")
+    print()
+    print("| stages | " + " | ".join(PRINTS) + " |")
+    print("|" + "---|" * (len(PRINTS) + 1))
+    peer = None
+    for name, label in pairs:
+        rows, _, _ = load(work, name)
+        cells = []
+        for k in range(len(PRINTS)):
+            sel = [r for r in rows if int(r["group"]) % len(PRINTS) == k]
+            ex, _ = errors(sel, *PEER_BIN)
+            cells.append(rms(ex))
+        if peer is None:
+            peer = cells
+        print(
+            f"| {label} | "
+            + " | ".join(f"{fmt(c)} ({c / p:.1f}x)" for c, p in zip(cells, peer))
+            + " |"
+        )
 
 
 if __name__ == "__main__":
