@@ -109,37 +109,48 @@ const DrawableKey* drawableKey(const std::string& key)
 	return nullptr;
 }
 
-/** The choice keys and the names one of them draws from with "any". */
+/** The choice keys, the names one of them draws from with "any", and how
+ * each sets and names its member of RenderOptions. */
 struct ChoiceKey
 {
 	const char* key;
 	std::vector<std::string> any;
+	void (*set)(RenderOptions&, const std::string& key, const std::string& name);
+	std::string (*name)(const RenderOptions&);
 };
 const ChoiceKey kChoices[] = {
-	{"bayer", {"RGGB", "BGGR", "GRBG", "GBRG"}},
-	{"demosaic", {"bilinear", "vng", "edge-aware"}},
-	{"transfer", {"linear", "srgb", "gamma", "filmic"}},
-	{"chroma_subsampling", {"none", "422", "420"}},
+	{"bayer",
+	 {"RGGB", "BGGR", "GRBG", "GBRG"},
+	 [](RenderOptions& o, const std::string& k, const std::string& n)
+	 { o.bayer = bayerFromName(n, k); },
+	 [](const RenderOptions& o) -> std::string { return bayerName(o.bayer); }},
+	{"demosaic",
+	 {"bilinear", "vng", "edge-aware"},
+	 [](RenderOptions& o, const std::string& k, const std::string& n)
+	 { o.demosaic = demosaicFromName(n, k); },
+	 [](const RenderOptions& o) -> std::string { return demosaicName(o.demosaic); }},
+	{"transfer",
+	 {"linear", "srgb", "gamma", "filmic"},
+	 [](RenderOptions& o, const std::string& k, const std::string& n)
+	 { o.transfer = transferFromName(n, k); },
+	 [](const RenderOptions& o) -> std::string { return transferName(o.transfer); }},
+	{"chroma_subsampling",
+	 {"none", "422", "420"},
+	 [](RenderOptions& o, const std::string& k, const std::string& n)
+	 { o.chroma_subsampling = chromaFromName(n, k); },
+	 [](const RenderOptions& o) -> std::string { return chromaName(o.chroma_subsampling); }},
 };
+
+const ChoiceKey& choiceKey(const std::string& key)
+{
+	for (const auto& k : kChoices)
+		if (key == k.key) return k;
+	throw std::logic_error("not a choice key: " + key);
+}
 
 void setChoice(RenderOptions& o, const std::string& key, const std::string& name)
 {
-	if (key == "bayer")
-		o.bayer = bayerFromName(name, key);
-	else if (key == "demosaic")
-		o.demosaic = demosaicFromName(name, key);
-	else if (key == "chroma_subsampling")
-		o.chroma_subsampling = chromaFromName(name, key);
-	else
-		o.transfer = transferFromName(name, key);
-}
-
-std::string choiceName(const RenderOptions& o, const std::string& key)
-{
-	if (key == "bayer") return bayerName(o.bayer);
-	if (key == "demosaic") return demosaicName(o.demosaic);
-	if (key == "chroma_subsampling") return chromaName(o.chroma_subsampling);
-	return transferName(o.transfer);
+	choiceKey(key).set(o, key, name);
 }
 
 template <typename D>
@@ -221,7 +232,7 @@ void loadDrawableKeys(
 		if (names.size() == 1 && (names[0] == "any" || names[0] == "ANY")) names = k.any;
 		try
 		{
-			for (const auto& n : names) setChoice(o, k.key, n);
+			for (const auto& n : names) k.set(o, k.key, n);
 		}
 		catch (const std::invalid_argument& e)
 		{
@@ -231,7 +242,7 @@ void loadDrawableKeys(
 		if (names.size() > 1)
 		{
 			o.choice_draws.push_back({k.key, names});
-			setChoice(o, k.key, names[0]);
+			k.set(o, k.key, names[0]);
 		}
 	}
 }
@@ -289,10 +300,7 @@ void RenderOptions::applyPreset(const std::string& name)
 	// The camera's keys start from their defaults; the scene's stay.
 	const RenderOptions d;
 	for (const auto& k : kDrawable) k.set(*this, k.get(d));
-	bayer = d.bayer;
-	demosaic = d.demosaic;
-	transfer = d.transfer;
-	chroma_subsampling = d.chroma_subsampling;
+	for (const auto& k : kChoices) k.set(*this, k.key, k.name(d));
 	range_draws.clear();
 	choice_draws.clear();
 	mrpt::config::CConfigFileMemory mem;
@@ -473,7 +481,7 @@ void RenderOptions::saveToConfigFile(
 	}
 	for (const auto& k : kChoices)
 	{
-		std::string v = choiceName(*this, k.key);
+		std::string v = k.name(*this);
 		for (const auto& d : choice_draws)
 			if (d.key == k.key)
 			{
