@@ -50,12 +50,12 @@ def main():
     pairs = list(zip(sys.argv[2::2], sys.argv[3::2]))
     head = ["stages", "detected"]
     head += [f"x / y {lo}-{hi} px" if hi != math.inf else f"x / y >= {lo} px" for lo, hi in BINS]
-    head += ["x 25-80 px", "y 25-80 px"]
+    head += [f"{axis} {PEER_BIN[0]}-{PEER_BIN[1]} px" for axis in ("x", "y")]
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * len(head))
+    runs = [(label, *load(work, name)) for name, label in pairs]
     peer = None
-    for name, label in pairs:
-        rows, found, missed = load(work, name)
+    for label, rows, found, missed in runs:
         cells = [label, f"{100 * found / max(1, found + missed):.1f}%"]
         for lo, hi in BINS:
             ex, ey = errors(rows, lo, hi)
@@ -72,15 +72,14 @@ def main():
     print()
     print("## Per print")
     print()
-    print("RMS error of x [px] over the widths 25-80 px per print (the CSV's group")
+    print(f"RMS error of x [px] over the widths {PEER_BIN[0]}-{PEER_BIN[1]} px per print (the CSV's group")
     print("modulo 3, as codemark-bench-pose-calib --vary-scene cycles them; every")
     print("light in each), as a ratio to the sensor row's for the same print:")
     print()
     print("| stages | " + " | ".join(PRINTS) + " |")
     print("|" + "---|" * (len(PRINTS) + 1))
     peer = None
-    for name, label in pairs:
-        rows, _, _ = load(work, name)
+    for label, rows, _, _ in runs:
         cells = []
         for k in range(len(PRINTS)):
             sel = [r for r in rows if int(r["group"]) % len(PRINTS) == k]

@@ -321,7 +321,8 @@ TEST(CameraPipeline, ChromaSubsamplingKeepsLumaAndAveragesColour)
 		cv::cvtColor(f, out, cv::COLOR_BGR2YCrCb);
 		return out;
 	};
-	const cv::Vec3f mean = 0.5f * (ycc(cols).at<cv::Vec3f>(0, 0) + ycc(cols).at<cv::Vec3f>(0, 1));
+	const cv::Mat cols_ycc = ycc(cols);
+	const cv::Vec3f mean = 0.5f * (cols_ycc.at<cv::Vec3f>(0, 0) + cols_ycc.at<cv::Vec3f>(0, 1));
 	// Interior pixels: luma kept, chroma the stripes' mean where the
 	// subsampling spans them, kept where it does not.
 	const auto check = [&](const cv::Mat& in, ChromaSubsampling s, bool averaged)
@@ -343,7 +344,7 @@ TEST(CameraPipeline, ChromaSubsamplingKeepsLumaAndAveragesColour)
 	check(rows, ChromaSubsampling::S420, true);
 	EXPECT_EQ(cv::norm(subsampleChroma(cols, ChromaSubsampling::None), cols, cv::NORM_INF), 0);
 	// The stripes' colours differ by far more than the tolerance.
-	EXPECT_GT(std::abs(ycc(cols).at<cv::Vec3f>(0, 0)[1] - mean[1]), 10);
+	EXPECT_GT(std::abs(cols_ycc.at<cv::Vec3f>(0, 0)[1] - mean[1]), 10);
 }
 
 TEST(CameraPipeline, ChromaSubsamplingKey)
