@@ -289,3 +289,126 @@ TEST(EdgeModels, PolicyPicksTheLocatorFromTheSidesProperties)
 			EXPECT_LT((r->corners_raw[k] - truth[k]).norm(), 0.05) << x.name << ", corner " << k;
 	}
 }
+
+namespace
+{
+/** An office printer's green (B, G, R): R and B well above the frame's
+ * black, as printed greens are (on #00FF00 paper R and B sit at the
+ * sensor's black, where decoding a subsampled chroma clips them, and luma
+ * then carries part of the chroma too). */
+const cv::Scalar kPrintedGreen(70, 170, 45);
+
+/** printImage()'s print with the fill kPrintedGreen and its inner square
+ * [o, o + side) moved by \a shift px (o = 2 frame + 20), rendered at 4x
+ * and averaged down, with Gaussian noise of \a noise_grey grey levels per
+ * channel. */
+PrintImage shiftedPrintImage(int side, int frame, double shift, double noise_grey)
+{
+	constexpr int k = 4;
+	const double o = 2 * frame + 20 + shift;
+	const int size = side + 2 * (2 * frame + 20);
+	cv::Mat light(k * size, k * size, CV_32FC3, cv::Scalar(200, 200, 200));
+	const auto rect = [&](double at, double width)
+	{
+		const int a = static_cast<int>(std::lround(k * at)),
+				  b = static_cast<int>(std::lround(k * (at + width)));
+		return cv::Rect(a, a, b - a, b - a);
+	};
+	cv::rectangle(light, rect(o - frame, side + 2 * frame), cv::Scalar(25, 25, 25), cv::FILLED);
+	cv::rectangle(light, rect(o, side), kPrintedGreen, cv::FILLED);
+	cv::GaussianBlur(light, light, cv::Size(0, 0), 0.8 * k);
+	cv::resize(light, light, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+	cv::Mat noise(light.size(), light.type());
+	cv::RNG rng(7);
+	rng.fill(noise, cv::RNG::NORMAL, 0, noise_grey);
+	light += noise;
+	PrintImage out;
+	light.convertTo(out.bgr, CV_8UC3);
+	const double a = o - 0.5, b = o + side - 0.5;
+	out.coarse = {
+		Eigen::Vector2d(a + 0.3, a - 0.2), Eigen::Vector2d(b - 0.2, a + 0.3),
+		Eigen::Vector2d(b + 0.2, b - 0.3), Eigen::Vector2d(a - 0.3, b + 0.2)};
+	return out;
+}
+}  // namespace
+
+// A wide frame's side is read in luma where the camera's colour has less
+// resolution than its luma, in G where it has the full resolution. Through
+// 4:2:0 chroma subsampling, with the edges a quarter pixel into a 2-px
+// chroma cell, decoded G carries part of a printed green's step at the
+// chroma's resolution: G's edge response is wider than luma's on every
+// side, and without noise luma's corners are the closer. With the colour
+// at full resolution both see one edge shape, and G, to which luma's R and
+// B would only add their noise, is kept on every side.
+TEST(EdgeModels, LumaReadsWideSidesWhereTheChromaIsSubsampled)
+{
+	const SubpixelParams p;
+	const double frame_ratio = 0.125, fill_ratio = 35.0 / 160;
+	const int side_px = 80, frame = 10;
+	for (const double noise : {0.0, 1.5})
+		for (const double shift : {0.25, 0.75})
+			for (const bool subsampled : {false, true})
+			{
+				PrintImage img = shiftedPrintImage(side_px, frame, shift, noise);
+				if (subsampled)
+					img.bgr = sim::subsampleChroma(img.bgr, sim::ChromaSubsampling::S420);
+				const std::string what = std::string(subsampled ? "4:2:0" : "full colour") +
+										 ", noise " + std::to_string(noise) + ", shift " +
+										 std::to_string(shift);
+				for (int side = 0; side < 4; ++side)
+				{
+					SCOPED_TRACE(what + ", side " + std::to_string(side));
+					const SideProfiles green =
+						readSideProfiles(img.bgr, img.coarse, side, frame_ratio, fill_ratio, p);
+					const LocatorChoice c = chooseLocator(measureSide(green), p);
+					ASSERT_EQ(c.kind, LocatorKind::Centroid);
+					EXPECT_EQ(c.channel, EdgeChannel::Luma);
+					SideProfiles luma = green;
+					readLumaProfiles(img.bgr, luma);
+					// Luma at the same samples, on the fill and in the frame (25
+					// grey: 25 / 0.587).
+					const int* l = luma.gAt(luma.count() / 2);
+					const double fill_luma = (0.114 * kPrintedGreen[0] + 0.587 * kPrintedGreen[1] +
+											  0.299 * kPrintedGreen[2]) /
+											 0.587;
+					EXPECT_NEAR(l[luma.n - 1], fill_luma, 6);
+					EXPECT_NEAR(l[luma.half - 5], 25 / 0.587, 6);
+					const auto locator = makeLocator(c, 5, p);
+					EXPECT_EQ(
+						lumaIsSharper(
+							green, locateEdges(green, *locator), luma, locateEdges(luma, *locator)),
+						subsampled);
+				}
+				const double a = 2 * frame + 20 + shift - 0.5, b = a + side_px;
+				const Quad truth{
+					Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b),
+					Eigen::Vector2d(a, b)};
+				const auto error = [&](const SubpixelModels& m, EdgeChannel expected)
+				{
+					const auto r = refineQuadrangle(
+						img.bgr, img.coarse, CameraModel(), 5, frame_ratio, p, fill_ratio, m);
+					EXPECT_TRUE(r) << what;
+					if (!r) return 1e9;
+					double sum = 0;
+					for (int k = 0; k < 4; ++k)
+					{
+						EXPECT_EQ(r->channel[k], expected) << what << ", side " << k;
+						sum += (r->corners_raw[k] - truth[k]).norm();
+					}
+					return sum / 4;
+				};
+				SubpixelModels g_only;
+				g_only.luma_edges = false;
+				const double e_g = error(g_only, EdgeChannel::Green);
+				const double e = error({}, subsampled ? EdgeChannel::Luma : EdgeChannel::Green);
+				if (!subsampled)
+				{
+					EXPECT_EQ(e, e_g) << what;
+				}
+				else if (noise == 0)
+				{
+					EXPECT_LT(e, 0.5 * e_g) << what << ": " << e << " px against G's " << e_g;
+				}
+				EXPECT_LT(e, 0.03) << what;
+			}
+}

@@ -22,6 +22,22 @@
 
 namespace codemark::detect
 {
+double medianOf(std::vector<double>& x)
+{
+	std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+	return x[x.size() / 2];
+}
+
+MedianWithError medianWithError(std::vector<double> x)
+{
+	const size_t n = x.size();
+	const double median = medianOf(x);
+	for (double& v : x) v = std::abs(v - median);
+	// A normal sample's sigma is 1.4826 MADs; its median's standard error
+	// sqrt(pi / 2) sigma / sqrt(n).
+	return {median, 1.4826 * medianOf(x) * std::sqrt(M_PI / 2 / n)};
+}
+
 namespace
 {
 /** The search around each predicted edge [+- px]: the bend (a few tenths
@@ -59,17 +75,10 @@ EdgeMode bandLocator(double frame_px, const SubpixelParams& p)
 	return frame_px >= p.min_frame_px_centroid ? EdgeMode::Centroid : EdgeMode::Peak;
 }
 
-/** The median of \a x (reordered; not empty). */
-double medianOf(std::vector<double>& x)
-{
-	std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
-	return x[x.size() / 2];
-}
-
 /** Whether the bands read wider or narrower than printed beyond their
  * own scatter: \a excess holds each profile's measured minus predicted
  * band width [px]; its median must lie at least kMinZ of its standard
- * errors (from the median absolute deviation) from 0. A camera's
+ * errors from 0 (medianWithError()). A camera's
  * response, or a clipped fill, moves both edges of a band outwards (each
  * edge's dark side is outside the band), printers' dot gain inwards; in
  * linear light, unclipped, neither edge moves, the single-edge locators
@@ -77,15 +86,9 @@ double medianOf(std::vector<double>& x)
  * would only add their scatter. */
 bool bandsShowBend(std::vector<double> excess)
 {
-	const size_t n = excess.size();
-	if (static_cast<int>(n) < kMinProfiles) return false;
-	const double median = medianOf(excess);
-	std::vector<double> dev(n);
-	for (size_t i = 0; i < n; ++i) dev[i] = std::abs(excess[i] - median);
-	// A normal sample's sigma is 1.4826 MADs; its median's standard error
-	// sqrt(pi / 2) sigma / sqrt(n).
-	const double se = 1.4826 * medianOf(dev) * std::sqrt(M_PI / 2 / n);
-	return std::abs(median) >= kMinZ * se;
+	if (static_cast<int>(excess.size()) < kMinProfiles) return false;
+	const MedianWithError m = medianWithError(std::move(excess));
+	return std::abs(m.median) >= kMinZ * m.se;
 }
 
 /** Across coordinate at along coordinate \a s of the segment \a p0 - \a p1
@@ -170,11 +173,18 @@ bool centreOnBandOnce(
 				if (s < 0 || s >= (along == 1 ? H : W) || c_first < 0 ||
 					c_last >= (along == 1 ? W : H))
 					continue;
+				const EdgeMode mode = bandLocator(frame_px, p);
+				// The side's channel (lumaIsSharper()) where the centroid
+				// reads the band.
+				const bool luma =
+					mode == EdgeMode::Centroid && q.channel[side] == EdgeChannel::Luma;
 				v.resize(n);
 				for (int i = 0; i < n; ++i)
 				{
 					const int x = base + inward * i;
-					v[i] = along == 1 ? bgr.at<cv::Vec3b>(s, x)[1] : bgr.at<cv::Vec3b>(x, s)[1];
+					const uint8_t* px =
+						along == 1 ? bgr.ptr<uint8_t>(s) + 3 * x : bgr.ptr<uint8_t>(x) + 3 * s;
+					v[i] = luma ? lumaLevel(px) : px[1];
 				}
 				const double t_in = inward * (*c_in - base), t_cell = inward * (*c_cell - base);
 				const int ki = static_cast<int>(std::lround(t_in)),
@@ -184,7 +194,6 @@ bool centreOnBandOnce(
 				// derivative's peak away from it, more from the narrower
 				// frame: the peak locator removes a model of that lobe.
 				const double cell_px = next_green ? width * cell / depth : 0;
-				const EdgeMode mode = bandLocator(frame_px, p);
 				const auto e_in = locateRisingEdge(
 					v.data(), n, std::max(1, ki - kSearch), std::min(n - 2, ki + kSearch), min_rise,
 					p, mode, frame_px);

@@ -96,6 +96,71 @@ SideProfiles readSideProfiles(
 	return out;
 }
 
+void readLumaProfiles(const cv::Mat& bgr, SideProfiles& side)
+{
+	for (size_t j = 0; j < side.count(); ++j)
+		for (int i = 0; i < side.n; ++i)
+		{
+			const int c = side.origin[j] + side.inward * (i - side.half);
+			const uint8_t* px = side.along == 1 ? bgr.ptr<uint8_t>(side.pos[j]) + 3 * c
+												: bgr.ptr<uint8_t>(c) + 3 * side.pos[j];
+			side.g[j * side.n + i] = lumaLevel(px);
+		}
+}
+
+namespace
+{
+/** Response widths compared within this many samples of the edge. */
+constexpr int kWidthReach = 3;
+/** lumaIsSharper(): the width difference's least significance [standard
+ * errors] and the fewest profiles. */
+constexpr double kMinSharperZ = 3;
+/** lumaIsSharper(): the least widening of G's response that counts, as a
+ * fraction of its second moment. Chroma at half resolution adds about
+ * 0.41 x 4/12 px^2 to it (G carries 41% of a green fill's step through
+ * the chroma, whose 2-px cells add 4/12 px^2): 15-30% of a focused edge's.
+ * Less is what the sensor's clip at black does to luma's R and B tails
+ * where the fill's R and B are black (up to about 10% on a dim, blurred
+ * edge), not the camera's chroma. */
+constexpr double kMinWiden = 0.15;
+constexpr int kMinSharperProfiles = 5;
+
+/** The second moment [px^2] about the edge \a e of \a v's central
+ * differences on its fill side, up to kWidthReach samples beyond it: the
+ * frame's outer edge lies on the other side, and the differences are
+ * summed as they are (not clipped at 0), so that noise cancels rather
+ * than widens. */
+double responseWidth2(const int* v, int n, double e)
+{
+	double s0 = 0, s2 = 0;
+	const int k0 = static_cast<int>(std::ceil(e));
+	for (int k = std::max(1, k0); k <= std::min(n - 2, k0 + kWidthReach); ++k)
+	{
+		const double d = v[k + 1] - v[k - 1];
+		s0 += d;
+		s2 += d * (k - e) * (k - e);
+	}
+	return s0 > 0 ? s2 / s0 : 0.0;
+}
+}  // namespace
+
+bool lumaIsSharper(
+	const SideProfiles& green, const std::vector<std::optional<double>>& green_edges,
+	const SideProfiles& luma, const std::vector<std::optional<double>>& luma_edges)
+{
+	std::vector<double> narrower, green_width;
+	for (size_t j = 0; j < std::min(green_edges.size(), luma_edges.size()); ++j)
+		if (green_edges[j] && luma_edges[j])
+		{
+			green_width.push_back(responseWidth2(green.gAt(j), green.n, *green_edges[j]));
+			narrower.push_back(
+				green_width.back() - responseWidth2(luma.gAt(j), luma.n, *luma_edges[j]));
+		}
+	if (static_cast<int>(narrower.size()) < kMinSharperProfiles) return false;
+	const MedianWithError m = medianWithError(std::move(narrower));
+	return m.median > kMinSharperZ * m.se && m.median >= kMinWiden * medianOf(green_width);
+}
+
 SideProperties measureSide(const SideProfiles& side)
 {
 	const int half_count = static_cast<int>(side.count()) / 2;
@@ -127,7 +192,11 @@ LocatorChoice chooseLocator(
 	const double outer = models.outer_edge ? s.frame_px : 0.0;
 	// An unsaturated fill: the centroid, unless the frame's outer edge
 	// overlaps the response.
-	if (!s.saturated) return thin ? LocatorChoice{LocatorKind::Peak, outer} : LocatorChoice{};
+	if (!s.saturated)
+		return thin ? LocatorChoice{LocatorKind::Peak, outer}
+					: LocatorChoice{
+						  LocatorKind::Centroid, 0.0,
+						  models.luma_edges ? EdgeChannel::Luma : EdgeChannel::Green};
 	// A saturated fill cuts the response's bright side, which pulls its
 	// centroid towards the frame; the peak barely moves until the clip
 	// comes within a sample of it (0.2-0.4 px at gain 1.2-1.5). Then R + B

@@ -61,6 +61,25 @@ SideProfiles readSideProfiles(
 	const cv::Mat& bgr, const Quad& coarse, int side, double frame_ratio, double fill_ratio,
 	const SubpixelParams& p);
 
+/** \a side's profiles (G) read again in luma (lumaLevel()) at the same
+ * samples. */
+void readLumaProfiles(const cv::Mat& bgr, SideProfiles& side);
+
+/** Whether a side's edges read in luma (\a luma, \a luma_edges: the same
+ * profiles through readLumaProfiles()) are sharper than in G (\a green,
+ * \a green_edges): each profile's response width (the second moment of
+ * its central differences within 3 samples on the edge's fill side), G's
+ * less luma's, must have its median at least 3 of its standard errors
+ * above 0 (medianWithError()) and at least 15% of G's own, over at least
+ * 5 profiles. Where the colour has the image's full resolution, G
+ * and luma see one edge shape and G is the better read (luma adds the R
+ * and B channels' noise for little contrast); a camera's chroma
+ * subsampling, its JPEG's coarser chroma or its demosaicing widens G's
+ * edge and not luma's. */
+bool lumaIsSharper(
+	const SideProfiles& green, const std::vector<std::optional<double>>& green_edges,
+	const SideProfiles& luma, const std::vector<std::optional<double>>& luma_edges);
+
 /** What the locator policy reads of a side. */
 struct SideProperties
 {
@@ -95,21 +114,29 @@ enum class LocatorKind
 };
 const char* locatorName(LocatorKind kind);
 
-/** A locator and its one parameter. */
+/** A locator, the channel it reads and its one parameter. */
 struct LocatorChoice
 {
 	LocatorKind kind = LocatorKind::Centroid;
 	/** Peak: the outer edge's distance before the inner one [px]; 0 for
 	 * none modelled. */
 	double outer_edge_px = 0;
+	EdgeChannel channel = EdgeChannel::Green;
 };
 
 /** The policy: the locator for a side with the properties \a s. Centroid
  * where the frame is wide (SubpixelParams::min_frame_px_centroid) and the
  * fill unsaturated; Peak with the outer edge's lobe on a thin frame; on a
  * saturated fill Peak (its centroid would lean towards the frame), unless
- * the clip reaches the edges of a wide frame: Channels. \a models switches
- * the outer edge's lobe off for experiments. */
+ * the clip reaches the edges of a wide frame: Channels. The centroid may
+ * read luma (lumaLevel(): free of the camera's chroma planes; where its
+ * edges are the sharper, lumaIsSharper()), the others read G: on
+ * a thin frame the wall beyond its outer edge is brighter against the
+ * fill in luma than in G (about 3x an office inkjet green's luma, 2x its
+ * G), and that edge's lobe then outweighs the inner edge's response in
+ * the peak's three samples; a clipped fill is clipped in G, which luma
+ * carries. \a models switches the outer edge's lobe and luma off for
+ * experiments. */
 LocatorChoice chooseLocator(
 	const SideProperties& s, const SubpixelParams& p, const SubpixelModels& models = {});
 

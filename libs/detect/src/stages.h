@@ -186,7 +186,44 @@ struct SubpixelModels
 	bool step_peak = true;
 	/** correctLevelRounding() on noise-free sharp sides. */
 	bool level_rounding = true;
+	/** Read the sides the centroid places, and their bands, in luma where
+	 * luma's edges are the sharper (lumaIsSharper()); false: all in G. */
+	bool luma_edges = true;
 };
+
+/** The median of \a x (reordered; not empty). */
+double medianOf(std::vector<double>& x);
+
+/** A sample's median and its standard error. */
+struct MedianWithError
+{
+	double median = 0, se = 0;
+};
+/** The median of \a x (not empty) and its standard error as a normal
+ * sample's (1.4826 median absolute deviations x sqrt(pi / 2 / n)): robust
+ * to the few wild profiles of a noisy side. */
+MedianWithError medianWithError(std::vector<double> x);
+
+/** The channel an edge is read in. */
+enum class EdgeChannel
+{
+	Green,
+	/** lumaLevel(): free of the chroma planes. */
+	Luma
+};
+
+/** BT.601 luma of a BGR pixel scaled to G's weight (Y / 0.587, rounded),
+ * so that on a pure green fill it reads G's levels and the gradient
+ * thresholds keep their meaning; up to 434 on white. Luma is the one
+ * combination of the decoded channels free of the chroma planes: a
+ * camera's chroma subsampling (4:2:2, 4:2:0) and JPEG's coarser chroma
+ * reach a colour edge's G through them (decoded G = Y - 0.344 Cb - 0.714
+ * Cr carries about 41% of a green fill's step against black at the
+ * chroma's resolution), and so does a Bayer mosaic's interpolated colour. */
+inline int lumaLevel(const uint8_t* bgr)
+{
+	return (114 * bgr[0] + 587 * bgr[1] + 299 * bgr[2] + 293) / 587;
+}
 
 /** How locateRisingEdge() places the edge. */
 enum class EdgeMode
@@ -447,6 +484,9 @@ struct RefinedQuad
 	std::array<LineFit, 4> sides;  //!< top, right, bottom, left, in undistorted px
 	/** Per side: its fill clipped throughout (DetectionQuality::fill_clipped). */
 	std::array<bool, 4> fill_clipped{{false, false, false, false}};
+	/** Per side: the channel its edges were read in. */
+	std::array<EdgeChannel, 4> channel{
+		{EdgeChannel::Green, EdgeChannel::Green, EdgeChannel::Green, EdgeChannel::Green}};
 };
 
 /** Edge profiles along each side of \a coarse (one per row or column), the
@@ -476,7 +516,10 @@ bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
  * moves alike), the median over the side's profiles; the corners follow.
  * Only where the bands' width differs from the printed one beyond its
  * scatter (a bend: a transfer curve, a clip, dot gain); otherwise \a q
- * stays as it is. \a fill_ratio: the band's width over the inner side. */
+ * stays as it is. \a fill_ratio: the band's width over the inner side.
+ * A side read in luma (RefinedQuad::channel) reads its bands in luma where
+ * the centroid reads them (a frame at least
+ * SubpixelParams::min_frame_px_centroid wide). */
 void centreOnBand(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, double fill_ratio, const SubpixelParams& p);

@@ -680,8 +680,9 @@ std::optional<RefinedQuad> refineQuadrangle(
 			return locateEdges(
 				prof, *makeLocator(chooseLocator(s, p, models), min_rise, p, models));
 		};
+		const LocatorChoice choice = chooseLocator(props, p, models);
+		const LocatorKind kind = choice.kind;
 		std::vector<std::optional<double>> edges = locateAll(props);
-		const LocatorKind kind = chooseLocator(props, p, models).kind;
 		// Undecided (a side along the pixel grid, one rounding of R + B all
 		// along): a fill above the top moves G's edges outwards only (its
 		// clip cuts the bright half of their response), by up to a tenth of
@@ -734,9 +735,24 @@ std::optional<RefinedQuad> refineQuadrangle(
 		if (models.thin_frame && !all_clipped && kind == LocatorKind::Peak && !props.saturated)
 			thin[side] = ThinSide{prof.g, edges, n, prof.inward, prof.across};
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
-		// levels' rounding is one for all its edges.
-		if (models.level_rounding && !clips && !all_clipped)
+		// levels' rounding is one for all its edges, and G so corrected is
+		// exact. Elsewhere the policy's channel: luma where it asks for it
+		// and G is whole (a clip's restorations are of G).
+		const bool rounded =
+			models.level_rounding && !clips && !all_clipped &&
 			correctLevelRounding(prof.g, n, prof.pos, prof.origin, prof.half, prof.inward, edges);
+		if (!rounded && !clips && choice.channel == EdgeChannel::Luma)
+		{
+			SideProfiles luma = prof;
+			readLumaProfiles(bgr, luma);
+			auto luma_edges = locateEdges(luma, *makeLocator(choice, min_rise, p, models));
+			if (lumaIsSharper(prof, edges, luma, luma_edges))
+			{
+				prof = std::move(luma);
+				edges = std::move(luma_edges);
+				out.channel[side] = EdgeChannel::Luma;
+			}
+		}
 		auto f = fitLine(edgePoints(prof, edges, cam), p);
 		if (!f) return false;
 		out.sides[side] = std::move(*f);
