@@ -179,26 +179,42 @@ TEST(EdgeModels, ChannelsFarFromGreensPeakAreNotTheEdge)
 namespace
 {
 /** An axis-aligned print on a wall, as a camera without a transfer curve
- * sees it: the inner square [o, o + side) px, a frame \a frame px wide
- * around it, fill G \a fill_g (R and B 5, darker than the frame; above 255 the sensor clips
- * it), blurred by 0.8 px; and the
- * coarse quadrangle of its inner corners, off by a few tenths of a pixel
- * as stage 6 leaves them. */
+ * sees it: the inner square [o, o + side) px with o = 2 frame + 20 +
+ * \a shift, a frame \a frame px wide around it, the fill \a fill (B, G,
+ * R; above 255 the sensor clips it), blurred by 0.8 px, with Gaussian
+ * noise of \a noise_grey grey levels per channel; and the coarse
+ * quadrangle of its inner corners, off by a few tenths of a pixel as stage
+ * 6 leaves them. A fractional \a shift is drawn at \a k x and averaged
+ * down. */
 struct PrintImage
 {
 	cv::Mat bgr;
 	Quad coarse;
 };
-PrintImage printImage(int side, int frame, int fill_g)
+PrintImage printImage(
+	int side, int frame, const cv::Scalar& fill, double shift = 0, double noise_grey = 0, int k = 1)
 {
-	const int o = 2 * frame + 20, size = side + 2 * o;
+	const double o = 2 * frame + 20 + shift;
+	const int size = side + 2 * (2 * frame + 20);
+	cv::Mat light(k * size, k * size, CV_32FC3, cv::Scalar(200, 200, 200));
+	const auto rect = [&](double at, double width)
+	{
+		const int a = static_cast<int>(std::lround(k * at)),
+				  b = static_cast<int>(std::lround(k * (at + width)));
+		return cv::Rect(a, a, b - a, b - a);
+	};
+	cv::rectangle(light, rect(o - frame, side + 2 * frame), cv::Scalar(25, 25, 25), cv::FILLED);
+	cv::rectangle(light, rect(o, side), fill, cv::FILLED);
+	cv::GaussianBlur(light, light, cv::Size(0, 0), 0.8 * k);
+	if (k > 1) cv::resize(light, light, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+	if (noise_grey > 0)
+	{
+		cv::Mat noise(light.size(), light.type());
+		cv::RNG rng(7);
+		rng.fill(noise, cv::RNG::NORMAL, 0, noise_grey);
+		light += noise;
+	}
 	PrintImage out;
-	cv::Mat light(size, size, CV_32FC3, cv::Scalar(200, 200, 200));
-	cv::rectangle(
-		light, cv::Rect(o - frame, o - frame, side + 2 * frame, side + 2 * frame),
-		cv::Scalar(25, 25, 25), cv::FILLED);
-	cv::rectangle(light, cv::Rect(o, o, side, side), cv::Scalar(5, fill_g, 5), cv::FILLED);
-	cv::GaussianBlur(light, light, cv::Size(0, 0), 0.8);
 	light.convertTo(out.bgr, CV_8UC3);	// rounds and clips at 255
 	const double a = o - 0.5, b = o + side - 0.5;
 	out.coarse = {
@@ -235,7 +251,7 @@ TEST(EdgeModels, PolicyPicksTheLocatorFromTheSidesProperties)
 			  0.05},
 			 {"clipped fill, thin frame", 32, 4, 400, true, true, LocatorKind::Peak, false, 0.5}})
 	{
-		const PrintImage img = printImage(x.side, x.frame, x.fill_g);
+		const PrintImage img = printImage(x.side, x.frame, cv::Scalar(5, x.fill_g, 5));
 		for (int side = 0; side < 4; ++side)
 		{
 			SCOPED_TRACE(std::string(x.name) + ", side " + std::to_string(side));
@@ -298,38 +314,6 @@ namespace
  * then carries part of the chroma too). */
 const cv::Scalar kPrintedGreen(70, 170, 45);
 
-/** printImage()'s print with the fill kPrintedGreen and its inner square
- * [o, o + side) moved by \a shift px (o = 2 frame + 20), rendered at 4x
- * and averaged down, with Gaussian noise of \a noise_grey grey levels per
- * channel. */
-PrintImage shiftedPrintImage(int side, int frame, double shift, double noise_grey)
-{
-	constexpr int k = 4;
-	const double o = 2 * frame + 20 + shift;
-	const int size = side + 2 * (2 * frame + 20);
-	cv::Mat light(k * size, k * size, CV_32FC3, cv::Scalar(200, 200, 200));
-	const auto rect = [&](double at, double width)
-	{
-		const int a = static_cast<int>(std::lround(k * at)),
-				  b = static_cast<int>(std::lround(k * (at + width)));
-		return cv::Rect(a, a, b - a, b - a);
-	};
-	cv::rectangle(light, rect(o - frame, side + 2 * frame), cv::Scalar(25, 25, 25), cv::FILLED);
-	cv::rectangle(light, rect(o, side), kPrintedGreen, cv::FILLED);
-	cv::GaussianBlur(light, light, cv::Size(0, 0), 0.8 * k);
-	cv::resize(light, light, cv::Size(size, size), 0, 0, cv::INTER_AREA);
-	cv::Mat noise(light.size(), light.type());
-	cv::RNG rng(7);
-	rng.fill(noise, cv::RNG::NORMAL, 0, noise_grey);
-	light += noise;
-	PrintImage out;
-	light.convertTo(out.bgr, CV_8UC3);
-	const double a = o - 0.5, b = o + side - 0.5;
-	out.coarse = {
-		Eigen::Vector2d(a + 0.3, a - 0.2), Eigen::Vector2d(b - 0.2, a + 0.3),
-		Eigen::Vector2d(b + 0.2, b - 0.3), Eigen::Vector2d(a - 0.3, b + 0.2)};
-	return out;
-}
 }  // namespace
 
 // A wide frame's side is read in luma where the camera's colour has less
@@ -349,7 +333,7 @@ TEST(EdgeModels, LumaReadsWideSidesWhereTheChromaIsSubsampled)
 		for (const double shift : {0.25, 0.75})
 			for (const bool subsampled : {false, true})
 			{
-				PrintImage img = shiftedPrintImage(side_px, frame, shift, noise);
+				PrintImage img = printImage(side_px, frame, kPrintedGreen, shift, noise, 4);
 				if (subsampled)
 					img.bgr = sim::subsampleChroma(img.bgr, sim::ChromaSubsampling::S420);
 				const std::string what = std::string(subsampled ? "4:2:0" : "full colour") +
