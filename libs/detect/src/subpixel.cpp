@@ -741,17 +741,22 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const bool rounded =
 			models.level_rounding && !clips && !all_clipped &&
 			correctLevelRounding(prof.g, n, prof.pos, prof.origin, prof.half, prof.inward, edges);
+		out.channel[side] = EdgeChannel::Green;
 		if (!rounded && !clips && choice.channel == EdgeChannel::Luma)
 		{
 			SideProfiles luma = prof;
 			readLumaProfiles(bgr, luma);
-			auto luma_edges = locateEdges(luma, *makeLocator(choice, min_rise, p, models));
+			const auto luma_edges = locateEdges(luma, *makeLocator(choice, min_rise, p, models));
+			// Luma where its edges are the sharper and its points make a
+			// line (a dim, defocused side can be sharper in luma and still
+			// too noisy for the fit's limits).
 			if (lumaIsSharper(prof, edges, luma, luma_edges))
-			{
-				prof = std::move(luma);
-				edges = std::move(luma_edges);
-				out.channel[side] = EdgeChannel::Luma;
-			}
+				if (auto f = fitLine(edgePoints(luma, luma_edges, cam), p))
+				{
+					out.sides[side] = std::move(*f);
+					out.channel[side] = EdgeChannel::Luma;
+					return true;
+				}
 		}
 		auto f = fitLine(edgePoints(prof, edges, cam), p);
 		if (!f) return false;
