@@ -115,6 +115,7 @@ constexpr int kWidthReach = 3;
 /** lumaIsSharper(): the width difference's least significance [standard
  * errors] and the fewest profiles. */
 constexpr double kMinSharperZ = 3;
+constexpr int kMinSharperProfiles = 5;
 /** lumaIsSharper(): the least widening of G's response that counts, as a
  * fraction of its second moment. Chroma at half resolution adds about
  * 0.41 x 4/12 px^2 to it (G carries 41% of a green fill's step through
@@ -123,7 +124,6 @@ constexpr double kMinSharperZ = 3;
  * where the fill's R and B are black (up to about 10% on a dim, blurred
  * edge), not the camera's chroma. */
 constexpr double kMinWiden = 0.15;
-constexpr int kMinSharperProfiles = 5;
 
 /** The second moment [px^2] about the edge \a e of \a v's central
  * differences on its fill side, up to kWidthReach samples beyond it: the

@@ -38,7 +38,9 @@ struct SideProfiles
 	 * proportions (perspective: in the ratio of this side's length to the
 	 * mean of it and the opposite one's). */
 	double frame_px = 0, fill_px = 0;
-	std::vector<int> g, rb;	 //!< n samples per profile
+	/** n samples per profile: G (luma after readLumaProfiles()) and
+	 * -(R + B). */
+	std::vector<int> g, rb;
 	std::vector<int> pos, origin;  //!< per profile [px]
 	/** Profiles whose fill side (beyond the search window) averages at
 	 * least SubpixelParams::saturation_level, and of those the ones that
