@@ -584,12 +584,7 @@ std::optional<ChannelFillLevel> fillLevelFromChannels(
 		rb_frame.push_back(-rb[k - 2]);
 		for (int i = i0; i <= i1; ++i) rb_fill.push_back(-rb[i]);
 	}
-	const auto median = [](std::vector<double>& v)
-	{
-		std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-		return v[v.size() / 2];
-	};
-	const double G0 = median(g_frame), RB0 = median(rb_frame), RB1 = median(rb_fill);
+	const double G0 = medianOf(g_frame), RB0 = medianOf(rb_frame), RB1 = medianOf(rb_fill);
 	constexpr double kMinStep = 12;
 	const double step = RB0 - RB1;
 	if (step < kMinStep) return std::nullopt;

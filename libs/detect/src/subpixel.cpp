@@ -503,8 +503,7 @@ std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelP
 			r[i] = std::abs(f.normal.dot(pts[i]) + f.c);
 			if (keep[i]) absr.push_back(r[i]);
 		}
-		std::nth_element(absr.begin(), absr.begin() + absr.size() / 2, absr.end());
-		const double sigma = 1.4826 * absr[absr.size() / 2];
+		const double sigma = 1.4826 * medianOf(absr);
 		const double limit = std::max(p.outlier_sigmas * sigma, p.min_outlier_px);
 		bool changed = false;
 		for (size_t i = 0; i < pts.size(); ++i)
@@ -567,8 +566,7 @@ void applyThinFrameModel(
 		if (hold)
 		{
 			if (sigmas.empty()) break;
-			std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
-			sigma = sigmas[sigmas.size() / 2];
+			sigma = medianOf(sigmas);
 		}
 		for (int side = 0; side < 4; ++side)
 		{
