@@ -335,23 +335,4 @@ std::vector<Eigen::Vector2d> edgePoints(
 	return pts;
 }
 
-std::vector<std::optional<double>> lineCrossings(
-	const SideProfiles& side, const std::vector<std::optional<double>>& edges,
-	const LineFit& line, const CameraModel& camera)
-{
-	// The line's signed distance grows by this much per sample along a
-	// profile (the profiles run across the axis nearer the side's normal:
-	// at least cos 45 deg).
-	const double rate = line.normal(side.across) * side.inward;
-	std::vector<std::optional<double>> out(edges.size());
-	for (size_t j = 0; j < edges.size(); ++j)
-	{
-		if (!edges[j]) continue;
-		Eigen::Vector2d pt = side.point(j, *edges[j]);
-		if (camera.hasDistortion()) pt = camera.undistortPixel(pt);
-		out[j] = *edges[j] - (line.normal.dot(pt) + line.c) / rate;
-	}
-	return out;
-}
-
 }  // namespace codemark::detect

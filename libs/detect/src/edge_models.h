@@ -175,14 +175,4 @@ std::vector<Eigen::Vector2d> edgePoints(
 	const SideProfiles& side, const std::vector<std::optional<double>>& edges,
 	const CameraModel& camera);
 
-/** Where \a line (fitted to \a side's edge points: undistorted px)
- * crosses each profile that has an edge in \a edges [samples along the
- * profile]; nullopt where \a edges has none. Read off each edge point's
- * distance to the line, along the profile: the point and its crossing
- * lie within the fit's residual, where the distortion's scale is 1 to a
- * few percent. */
-std::vector<std::optional<double>> lineCrossings(
-	const SideProfiles& side, const std::vector<std::optional<double>>& edges,
-	const LineFit& line, const CameraModel& camera);
-
 }  // namespace codemark::detect

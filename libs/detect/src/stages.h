@@ -299,29 +299,22 @@ std::optional<double> correctLevelRounding(
 	const std::vector<int>& origin, int half, int inward,
 	std::vector<std::optional<double>>& edges);
 
-/** The mean offset [px] of a thin frame's inner edges from \a edges
- * (profile index; \a g_profiles of \a n samples each): the side's
- * profiles, aligned on those edges, fitted together (least squares, 0.25
- * px bins) with a model of the print across the side, wall | quiet margin
- * | black frame | fill: levels W, M, K, G, one Gaussian blur (held at \a
- * fixed_sigma when > 0), the frame's width (started at \a frame_px) and
- * the margin's, and the inner edge's offset. The profiles are best aligned
- * on the side's fitted line (lineCrossings()): each profile's own edge
- * carries its locator's phase-dependent error, which the common offset
- * cannot undo. The peak model knows the frame's outer edge but not the
- * margin's: on a margin under a pixel (the spec's 5 mm beyond 3 m or at
- * 60 deg) the wall's edge to it cancels part of the outer edge's lobe, and
- * the peak's edges lie 0.05-0.1 px inwards on 2-3 px frames; a camera's
- * chroma subsampling, demosaicing or JPEG moves them by up to most of a
- * pixel. Nullopt without convergence, with under 8 edges, or where the
- * offset ends at its bound of 0.95 px (no minimum inside). \a sigma_out
- * receives the blur, \a cost_out the fit's weighted squared residuals
- * [grey levels^2]. Written by hand: one small fit per thin side, where
- * cv::LMSolver's set-up would cost more. */
+/** The mean offset [px] of a thin frame's inner edges from where the
+ * peak model put them (\a edges, profile index; \a g_profiles of \a n
+ * samples each): the side's profiles, aligned on those edges, fitted
+ * together (least squares, 0.25 px bins) with a model of the print across
+ * the side, wall | quiet margin | black frame | fill: levels W, M, K, G,
+ * one Gaussian blur, the frame's width (started at \a frame_px) and the
+ * margin's, and the inner edge's offset. The peak model knows the frame's
+ * outer edge but not the margin's: on a margin under a pixel (the spec's
+ * 5 mm beyond 3 m or at 60 deg) the wall's edge to it cancels part of the
+ * outer edge's lobe, and the peak's edges lie 0.05-0.1 px inwards on 2-3
+ * px frames. Nullopt without convergence, with under 8 edges, or where
+ * the offset would exceed half a pixel. Written by hand: one small fit per
+ * thin side, where cv::LMSolver's set-up would cost more. */
 std::optional<double> thinFrameOffset(
 	const std::vector<int>& g_profiles, int n, const std::vector<std::optional<double>>& edges,
-	double frame_px, double fixed_sigma = 0, double* sigma_out = nullptr,
-	double* cost_out = nullptr);
+	double frame_px, double fixed_sigma = 0, double* sigma_out = nullptr);
 
 /** The profiles of one side, for imputeClippedSide(): sample i of profile
  * j lies at across coordinate base[j] + inward * i (i grows into the fill)

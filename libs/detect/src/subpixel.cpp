@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 
 namespace codemark::detect
 {
@@ -26,13 +25,6 @@ constexpr double kGRoundingPx = 0.5 / 230;
  * from frames at least this wide. */
 constexpr double kMinThinModelPx = 2.0;
 constexpr double kMinBlurFramePx = 2.5;
-/** thinFrameOffset(): the offset's box [px], and how close to it an
- * offset counts as stuck there. */
-constexpr double kThinOffsetBoundPx = 1.0;
-constexpr double kThinOffsetAtBoundPx = 0.05;
-/** applyThinFrameModel(): the grid of the blur shared by sides none of
- * which spreads its phases [px] (thinFrameOffset()'s own bounds). */
-constexpr double kGridSigmaMinPx = 0.3, kGridSigmaMaxPx = 2.0, kGridSigmaStepPx = 0.1;
 /** Seed of the derivative peak's variance [px^2] for the outer-edge lobe
  * model when the three samples give none: a Gaussian edge blur of about
  * 0.6 px plus the central difference's 2-px box (4/12 px^2). */
@@ -293,7 +285,7 @@ std::optional<double> correctLevelRounding(
 
 std::optional<double> thinFrameOffset(
 	const std::vector<int>& g_profiles, int n, const std::vector<std::optional<double>>& edges,
-	double frame_px, double fixed_sigma, double* sigma_out, double* cost_out)
+	double frame_px, double fixed_sigma, double* sigma_out)
 {
 	constexpr double kBin = 0.25, kInside = 3.0, kBeyond = 4.0;
 	const double x0 = -(frame_px + kBeyond);
@@ -354,8 +346,7 @@ std::optional<double> thinFrameOffset(
 	Vec7 q;
 	q << W0.value_or(*M0), *M0, *K0, *G0, fixed_sigma > 0 ? fixed_sigma : 0.8, 1.0, 0.0;
 	// Bounds of the blur, the margin's width and the offset (t[4..6]).
-	const double lo_bound[3] = {0.2, 0.25 * frame_px, -kThinOffsetBoundPx},
-				 hi_bound[3] = {2.5, kBeyond, kThinOffsetBoundPx};
+	const double lo_bound[3] = {0.2, 0.25 * frame_px, -1.0}, hi_bound[3] = {2.5, kBeyond, 1.0};
 	const auto clampParams = [&](Vec7& t)
 	{
 		t[4] = fixed_sigma > 0 ? fixed_sigma : std::clamp(t[4], lo_bound[0], hi_bound[0]);
@@ -446,8 +437,7 @@ std::optional<double> thinFrameOffset(
 			converged = mu > 1e6;
 		}
 	}
-	// An offset at its bound is no minimum of the model.
-	if (std::abs(q[6]) > kThinOffsetBoundPx - kThinOffsetAtBoundPx) return std::nullopt;
+	if (std::abs(q[6]) > 0.5) return std::nullopt;
 	// The offset's standard error (the bins' residual variance), and the
 	// offset shrunk by it: d^2 / (d^2 + se^2) of it, so that sides whose
 	// profiles show no shift (a wide margin, a frame over 4 px) keep their
@@ -464,7 +454,6 @@ std::optional<double> thinFrameOffset(
 	const double var = (cost / dof) * Hf.inverse()(6, 6);
 	if (!(var >= 0)) return std::nullopt;
 	if (sigma_out) *sigma_out = q[4];
-	if (cost_out) *cost_out = cost;
 	const double d2 = q[6] * q[6];
 	return q[6] * d2 / (d2 + var);
 }
@@ -545,21 +534,16 @@ namespace
  * applyThinFrameModel(): its profiles and edges. */
 struct ThinSide
 {
-	SideProfiles prof;
+	std::vector<int> g;
 	std::vector<std::optional<double>> edges;
+	int n, inward, across;
 };
 
 /** The thin sides' model of the print (thinFrameOffset()) applied to
  * \a out's lines: the frame's width across each from the refined square's
  * homography (the ratio of the sides' lengths goes as the depth, a
- * foreshortened width as its square), the profiles aligned on each side's
- * fitted line, one blur for the landmark. The blur is fitted first on
- * sides whose frames are wide enough to show it and whose profiles spread
- * over the pixel's phases (a side slanting across the grid), then held on
- * the others; where no side spreads its phases (a landmark seen squarely,
- * its sides along the grid), each side shows the blur at its own phase,
- * and the blur is the one with the least residual summed over the sides
- * (a grid of blurs). */
+ * foreshortened width as its square), one blur for the landmark, fitted
+ * first on sides whose frames are wide enough to show it. */
 void applyThinFrameModel(
 	RefinedQuad& out, const std::array<std::optional<ThinSide>, 4>& thin, const CameraModel& cam,
 	double frame_ratio)
@@ -573,76 +557,45 @@ void applyThinFrameModel(
 	}
 	// The lines, and so these corners, are in ideal pixels.
 	const FaceMap toPixel{faceToImage(refined), cam, false};
-	std::array<double, 4> width{};
-	std::array<std::vector<std::optional<double>>, 4> aligned;
-	for (int side = 0; side < 4; ++side)
-	{
-		if (!thin[side]) continue;
-		const SideProfiles& prof = thin[side]->prof;
-		const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
-		const Eigen::Vector2d in = 0.5 * (f0 + f1), outer = in + frame_ratio * (f0 + f1);
-		width[side] = std::abs(toPixel(outer)(prof.across) - toPixel(in)(prof.across));
-		aligned[side] = lineCrossings(prof, thin[side]->edges, out.sides[side], cam);
-	}
-	// Under 2 px the frame never reaches its black: the model cannot tell
-	// it from the margin (the fit's levels and blur wander), and the peak
-	// model's edges stay.
-	const auto fitted = [&](int side) { return thin[side] && width[side] >= kMinThinModelPx; };
-	const auto fit = [&](int side, double sigma, double* sigma_out, double* cost_out)
-	{
-		const SideProfiles& prof = thin[side]->prof;
-		return thinFrameOffset(
-			prof.g, prof.n, aligned[side], width[side], sigma, sigma_out, cost_out);
-	};
-	std::array<std::optional<double>, 4> offsets;
 	std::vector<double> sigmas;
-	for (int side = 0; side < 4; ++side)
+	std::array<double, 4> offsets{};
+	std::array<bool, 4> done{};
+	for (const bool hold : {false, true})
 	{
-		if (!fitted(side)) continue;
 		double sigma = 0;
-		offsets[side] = fit(side, 0.0, &sigma, nullptr);
-		if (offsets[side] && width[side] >= kMinBlurFramePx) sigmas.push_back(sigma);
-	}
-	double held = sigmas.empty() ? 0.0 : medianOf(sigmas);
-	if (sigmas.empty())
-	{
-		double best_cost = std::numeric_limits<double>::infinity();
-		for (double sigma = kGridSigmaMinPx; sigma <= kGridSigmaMaxPx + 1e-9;
-			 sigma += kGridSigmaStepPx)
+		if (hold)
 		{
-			std::array<std::optional<double>, 4> at;
-			double total = 0;
-			int count = 0;
-			for (int side = 0; side < 4; ++side)
+			if (sigmas.empty()) break;
+			sigma = medianOf(sigmas);
+		}
+		for (int side = 0; side < 4; ++side)
+		{
+			if (!thin[side] || done[side]) continue;
+			const ThinSide& t = *thin[side];
+			const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
+			const Eigen::Vector2d in = 0.5 * (f0 + f1), outer = in + frame_ratio * (f0 + f1);
+			const double width = std::abs(toPixel(outer)(t.across) - toPixel(in)(t.across));
+			// Under 2 px the frame never reaches its black: the model cannot
+			// tell it from the margin (the fit's levels and blur wander), and
+			// the peak model's edges stay.
+			if (width < kMinThinModelPx) continue;
+			double fitted_sigma = 0;
+			if (const auto d = thinFrameOffset(t.g, t.n, t.edges, width, sigma, &fitted_sigma))
 			{
-				if (!fitted(side) || width[side] < kMinBlurFramePx) continue;
-				double cost = 0;
-				at[side] = fit(side, sigma, nullptr, &cost);
-				if (!at[side]) continue;
-				total += cost;
-				++count;
-			}
-			// Two sides at least: one side's phase alone trades its blur
-			// against its offset.
-			if (count >= 2 && total < best_cost)
-			{
-				best_cost = total;
-				offsets = at;
-				held = sigma;
+				offsets[side] = *d;
+				done[side] = true;
+				if (!hold && width >= kMinBlurFramePx) sigmas.push_back(fitted_sigma);
 			}
 		}
 	}
-	if (held > 0)
-		for (int side = 0; side < 4; ++side)
-			if (fitted(side) && !offsets[side]) offsets[side] = fit(side, held, nullptr, nullptr);
 	// Each edge moves by the offset along its profile: the line by as much
 	// across (undistorted and raw pixels differ by the distortion's scale
 	// there, a few percent of a small shift).
 	for (int side = 0; side < 4; ++side)
-		if (offsets[side])
+		if (done[side])
 		{
 			LineFit& l = out.sides[side];
-			l.c -= l.normal(thin[side]->prof.across) * thin[side]->prof.inward * *offsets[side];
+			l.c -= l.normal(thin[side]->across) * thin[side]->inward * offsets[side];
 		}
 }
 }  // namespace
@@ -778,7 +731,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// once all four lines give the frame's width.
 		thin[side].reset();
 		if (models.thin_frame && !all_clipped && kind == LocatorKind::Peak && !props.saturated)
-			thin[side] = ThinSide{prof, edges};
+			thin[side] = ThinSide{prof.g, edges, n, prof.inward, prof.across};
 		// G read as it is (nothing imputed): on a noise-free sharp side, the
 		// levels' rounding is one for all its edges, and G so corrected is
 		// exact. Elsewhere the policy's channel: luma where it asks for it
