@@ -69,8 +69,7 @@ std::optional<double> centreCellNoise(const cv::Mat& bgr, const Quad& q, double 
 	// Half the cell, less the reach of a blur and of JPEG ringing.
 	auto diffs = centreCellDifferences(bgr, q, cell_rel, 2.5, 1, false);
 	if (!diffs) return std::nullopt;
-	std::nth_element(diffs->begin(), diffs->begin() + diffs->size() / 2, diffs->end());
-	return (*diffs)[diffs->size() / 2] * kMadToSigma;
+	return medianOf(*diffs) * kMadToSigma;
 }
 
 std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, double cell_rel)
@@ -89,9 +88,8 @@ std::optional<double> centreCellNoiseRms(const cv::Mat& bgr, const Quad& q, doub
 	// sigma from about 0.8 to 1.3): the RMS of the differences within 4
 	// robust sigmas (one more grey level for the rounding) instead, which a
 	// stray edge pixel does not move and a Gaussian loses 0.1% of.
-	// (The RMS below does not care about the order nth_element leaves.)
-	std::nth_element(diffs->begin(), diffs->begin() + diffs->size() / 2, diffs->end());
-	const double cut = 4 * std::sqrt(2.0) * (*diffs)[diffs->size() / 2] * kMadToSigma + 1;
+	// (The RMS below does not care about the order medianOf() leaves.)
+	const double cut = 4 * std::sqrt(2.0) * medianOf(*diffs) * kMadToSigma + 1;
 	double ss = 0;
 	int n = 0;
 	for (const double d : *diffs)
