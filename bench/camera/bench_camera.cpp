@@ -154,6 +154,9 @@ struct FrameResult
 	double phi2_err_rad = NAN;
 	double pos_err_m = NAN;	 // planar position of the camera in frame L
 	double nees = NAN;	// of C_R, 3 DoF
+	double line_rms_px = NAN;  // the four line fits' RMS residual, averaged
+	double corner_sigma_px = NAN;  // the detector's own corner sigma
+	double noise_grey = NAN;  // the image noise the detector measured
 };
 
 double wrapPi(double a) { return std::atan2(std::sin(a), std::cos(a)); }
@@ -192,6 +195,11 @@ FrameResult evaluate(
 		double sum = 0;
 		for (int k = 0; k < 4; ++k) sum += (c[k] - t.corners_px[k]).norm();
 		out.corner_err_px = sum / 4;
+		const DetectionQuality& q = m.detected.detection.quality;
+		out.line_rms_px =
+			0.25 * (q.line_rms_px[0] + q.line_rms_px[1] + q.line_rms_px[2] + q.line_rms_px[3]);
+		out.corner_sigma_px = q.corner_sigma_px;
+		out.noise_grey = q.image_noise_grey;
 		double w = 0, h = 0;
 		sideLengths(c, &w, &h);
 		out.width_err_px = w - w_true;
@@ -386,7 +394,7 @@ void writeCsv(const std::string& path, const std::vector<Run>& runs)
 	if (!os) throw std::runtime_error(path + ": cannot write");
 	os << "source,preset,group,index,distance_m,view_deg,light,print,side_px,"
 		  "eligible,detected,wrong_ids,corner_err_px,width_err_px,height_err_px,range_err_rel,"
-		  "phi2_err_deg,pos_err_m,nees\n";
+		  "phi2_err_deg,pos_err_m,nees,line_rms_px,corner_sigma_px,noise_grey\n";
 	for (const auto& run : runs)
 		for (const auto& r : run.frames)
 		{
@@ -396,7 +404,8 @@ void writeCsv(const std::string& path, const std::vector<Run>& runs)
 			   << "," << r.side_px << "," << r.eligible << "," << r.detected << "," << r.wrong_ids
 			   << "," << r.corner_err_px << "," << r.width_err_px << "," << r.height_err_px << ","
 			   << r.range_err_rel << "," << r.phi2_err_rad / kDeg << "," << r.pos_err_m << ","
-			   << r.nees << "\n";
+			   << r.nees << "," << r.line_rms_px << "," << r.corner_sigma_px << "," << r.noise_grey
+			   << "\n";
 		}
 }
 
@@ -440,7 +449,12 @@ int main(int argc, char** argv)
 			true, "", "DIR", cmd);
 		TCLAP::ValueArg<std::string> outArg(
 			"o", "out", "Markdown report", false, "", "FILE.md", cmd);
-		TCLAP::ValueArg<std::string> csvArg("", "csv", "per-frame CSV", false, "", "FILE.csv", cmd);
+		TCLAP::ValueArg<std::string> csvArg(
+			"", "csv",
+			"per-frame CSV: the frame, its errors and NEES, and what the detector measured of "
+			"the landmark (line_rms_px: the four line fits' RMS residual, averaged; "
+			"corner_sigma_px: the corner sigma the line fits give; noise_grey: the image noise)",
+			false, "", "FILE.csv", cmd);
 		TCLAP::ValueArg<std::string> revisionArg(
 			"", "revision", "revision named in the report", false, "", "TEXT", cmd);
 		TCLAP::ValueArg<int> threadsArg(
