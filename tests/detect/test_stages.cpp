@@ -1132,6 +1132,132 @@ TEST(Code, TheFrameCheckComparesTheInk)
 	EXPECT_FALSE(readCode(greyed, q, CameraModel(), g, CodeParams()));
 }
 
+namespace
+{
+/** Landmark \a id whose reference square spans \a w x \a h px (a view
+ * from the side foreshortens it), drawn 8 times finer, blurred there by
+ * \a blur px and averaged over each pixel; the square's corners lie at
+ * o - 0.5 and o + w - 0.5 (x), o + h - 0.5 (y). */
+cv::Mat narrowLandmark(int id, int w, int h, double blur, int o = 30, int size = 100)
+{
+	const int k = 8;
+	const double at = o * k, iw = w * k, ih = h * k;
+	cv::Mat fine(size * k, size * k, CV_8UC3, kWhite);
+	const auto box = [&](double x, double y, double bw, double bh, const cv::Scalar& c) {
+		cv::rectangle(
+			fine, cv::Rect(cvRound(x), cvRound(y), cvRound(bw), cvRound(bh)), c, cv::FILLED);
+	};
+	// The frame is 20 / 160 of the square, a cell 30 / 160.
+	box(at - iw / 8, at - ih / 8, iw * 10 / 8, ih * 10 / 8, kBlack);
+	box(at, at, iw, ih, kGreen);
+	const double cw = iw * 3 / 16, ch = ih * 3 / 16;
+	const CodeCells cells = encodeId(id);
+	for (int r = 0; r < 3; ++r)
+		for (int c = 0; c < 3; ++c)
+			if (cells[r][c])
+				box(at + iw / 2 + (c - 1.5) * cw, at + ih / 2 + (r - 1.5) * ch, cw, ch, kBlack);
+	if (blur > 0) cv::GaussianBlur(fine, fine, cv::Size(0, 0), blur * k);
+	cv::Mat img;
+	cv::resize(fine, img, cv::Size(size, size), 0, 0, cv::INTER_AREA);
+	return img;
+}
+}  // namespace
+
+TEST(Code, BlurSharesAreTheCellsWithoutBlurAndSpreadWithIt)
+{
+	const LandmarkGeometry g;
+	const CameraModel cam;
+	const FaceMap map{faceToImage(craftedCorners()), cam, false};
+	const auto sharp = blurredCellShares(map, g, 0.4, 1e-3);
+	const Eigen::Matrix<double, 9, 9> cells = sharp.topLeftCorner(9, 9);
+	EXPECT_LT((cells - Eigen::Matrix<double, 9, 9>::Identity()).cwiseAbs().maxCoeff(), 1e-9);
+	EXPECT_LT(sharp.col(9).head(9).cwiseAbs().maxCoeff(), 1e-9);
+	// The ring's patches lie on the ring alone.
+	EXPECT_LT((sharp.col(9).tail(4).array() - 1).abs().maxCoeff(), 1e-9);
+	EXPECT_LT(sharp.bottomRows(4).leftCols(9).cwiseAbs().maxCoeff(), 1e-9);
+	// A blur of a third of a cell (15 px here): each patch keeps most of its
+	// own cell, takes a share of its neighbours and none of a far cell; all
+	// shares of a patch sum to at most one (the frame is black).
+	const auto soft = blurredCellShares(map, g, 0.4, 5);
+	for (int i = 0; i < 9; ++i)
+	{
+		EXPECT_GT(soft(i, i), 0.6) << i;
+		EXPECT_LT(soft(i, i), 1) << i;
+		EXPECT_LE(soft.row(i).sum(), 1 + 1e-12) << i;
+	}
+	EXPECT_GT(soft(0, 1), 0.01);  // neighbours along a row
+	EXPECT_GT(soft(0, 3), 0.01);  // and a column
+	EXPECT_LT(soft(0, 8), 1e-3);  // opposite corners
+	EXPECT_GT(soft(0, 9), 0.01);  // a corner cell touches the ring
+	EXPECT_LT(soft(4, 9), soft(0, 9));	// the centre is farthest from it
+}
+
+TEST(Code, ThroughBlurIsTheThresholdOnSharpCells)
+{
+	// Cell means at two levels, each off by a few grey levels: the blur read
+	// finds the code and, for cells 15 px wide, the threshold's margin.
+	const LandmarkGeometry g;
+	const CameraModel cam;
+	const FaceMap map{faceToImage(craftedCorners()), cam, false};
+	std::mt19937 rng(3);
+	std::uniform_real_distribution<double> off(-8, 8);
+	const std::array<double, 4> ring{200, 200, 200, 200};
+	for (int id = 0; id < 256; id += 11)
+	{
+		const CodeCells cells = encodeId(id);
+		std::array<double, 9> m{};
+		double margin = 1e9;
+		for (int k = 0; k < 9; ++k)
+		{
+			m[k] = (cells[k / 3][k % 3] ? 30 : 200) + off(rng);
+			margin = std::min(margin, std::abs(m[k] - 115));
+		}
+		const auto r = readCellsThroughBlur(m, ring, 30, map, g, 0.4, 0.15, 1.5);
+		ASSERT_TRUE(r) << id;
+		EXPECT_EQ(decodeCells(r->cells), id);
+		EXPECT_NEAR(r->margin, margin, 10) << id;
+	}
+	// A cell halfway between the levels is ambiguous whatever the blur.
+	std::array<double, 9> m{};
+	const CodeCells cells = encodeId(0);
+	for (int k = 0; k < 9; ++k) m[k] = cells[k / 3][k % 3] ? 30 : 200;
+	m[0] = 115;
+	EXPECT_FALSE(readCellsThroughBlur(m, ring, 30, map, g, 0.4, 0.15, 1.5));
+}
+
+TEST(Code, ReadsANarrowBlurredBoard)
+{
+	// A landmark seen about 60 deg from its normal at 4-5 m: 10-12 x 30 px,
+	// its cells 2-2.3 px wide, blurred by 1-1.2 px. Where a cell's mean lies
+	// near the threshold between the frame's and the ring's levels (its
+	// neighbours' share), the cells are read through the blur; every ID is
+	// read, and read right.
+	const LandmarkGeometry g;
+	const CodeParams p;
+	for (const auto& [w, blur] : {std::pair{12, 1.2}, std::pair{10, 1.0}})
+	{
+		RefinedQuad q;
+		const double x0 = 30 - 0.5, y0 = 30 - 0.5;
+		q.corners_raw = q.corners_ideal = {
+			Eigen::Vector2d(x0, y0), Eigen::Vector2d(x0 + w, y0), Eigen::Vector2d(x0 + w, y0 + 30),
+			Eigen::Vector2d(x0, y0 + 30)};
+		int read = 0, through_blur = 0;
+		for (int id = 0; id < 256; id += 5)
+		{
+			const auto r = readCode(narrowLandmark(id, w, 30, blur), q, CameraModel(), g, p);
+			if (!r) continue;
+			++read;
+			EXPECT_EQ(r->id, id) << w;
+			const double thr = 0.5 * (r->green_g + r->black_g), contrast = r->green_g - r->black_g;
+			bool near = false;
+			for (const double c : r->cell_g) near |= std::abs(c - thr) < p.min_margin * contrast;
+			through_blur += near;
+		}
+		EXPECT_EQ(read, 52) << w;
+		EXPECT_GE(through_blur, 15) << w;
+	}
+}
+
 TEST(Code, AmbiguousCellIsRejected)
 {
 	const LandmarkGeometry g;

@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace codemark::detect
 {
@@ -105,6 +106,158 @@ std::optional<double> patchMean(
 }
 }  // namespace
 
+namespace
+{
+/** Mean over 5 samples evenly spread over [c - r, c + r] of the Gaussian
+ * (std \a s) blurred indicator of [a, b]. */
+double blurredInterval(double a, double b, double c, double r, double s)
+{
+	const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+	double sum = 0;
+	for (int k = -2; k <= 2; ++k)
+	{
+		const double x = c + r * k / 2.0;
+		sum += phi((b - x) / s) - phi((a - x) / s);
+	}
+	return sum / 5;
+}
+
+/** A code's green indicator: 1 for each green cell (false in CodeCells). */
+CodeCells cellsOfCode(int code)
+{
+	// The centre is black; bits 0..7 fill the other eight cells row by row.
+	CodeCells cells{};
+	int bit = 0;
+	for (int k = 0; k < 9; ++k)
+	{
+		if (k == 4)
+		{
+			cells[1][1] = true;
+			continue;
+		}
+		cells[k / 3][k % 3] = ((code >> bit++) & 1) != 0;
+	}
+	return cells;
+}
+}  // namespace
+
+BoardShares blurredCellShares(
+	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double sigma_px)
+{
+	const double h = geo.innerHalf(), cell = geo.cell_size_m / h, board = 1.5 * cell;
+	const double pr = 0.5 * patch_fraction * cell;
+	BoardShares A;
+	// Row i: a patch centred on c, half-sizes rx, ry, 5 x 5 samples. The
+	// blur in face coordinates is sigma^2 (J^T J)^-1, J the map's Jacobian
+	// at the patch; its marginal standard deviations are used. The patch
+	// is a product grid: its mean of a blurred rectangle is the product of
+	// the means along each axis.
+	const auto row = [&](int i, const Eigen::Vector2d& c, double rx, double ry)
+	{
+		const double e = 0.25 * cell;
+		Eigen::Matrix2d J;
+		J.col(0) = (map(c.x() + e, c.y()) - map(c.x() - e, c.y())) / (2 * e);
+		J.col(1) = (map(c.x(), c.y() + e) - map(c.x(), c.y() - e)) / (2 * e);
+		const Eigen::Matrix2d S = sigma_px * sigma_px * (J.transpose() * J).inverse();
+		const double sx = std::sqrt(std::max(S(0, 0), 1e-12)),
+					 sy = std::sqrt(std::max(S(1, 1), 1e-12));
+		const auto rect = [&](double x0, double x1, double y0, double y1)
+		{ return blurredInterval(x0, x1, c.x(), rx, sx) * blurredInterval(y0, y1, c.y(), ry, sy); };
+		for (int j = 0; j < 9; ++j)
+		{
+			const Eigen::Vector2d cj = geo.cellCentreFace(j / 3, j % 3) / h;
+			A(i, j) =
+				rect(cj.x() - cell / 2, cj.x() + cell / 2, cj.y() - cell / 2, cj.y() + cell / 2);
+		}
+		A(i, 9) = rect(-1, 1, -1, 1) - rect(-board, board, -board, board);
+	};
+	for (int i = 0; i < 9; ++i) row(i, geo.cellCentreFace(i / 3, i % 3) / h, pr, pr);
+	// The ring's patches of readCode(): three along each side's middle.
+	const double rg = 0.5 * (board + 1), band = 0.25 * (1 - board);
+	for (int side = 0; side < 4; ++side)
+	{
+		const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
+		Eigen::Matrix<double, 1, 10> sum = Eigen::Matrix<double, 1, 10>::Zero();
+		for (const double t : {-0.5, 0.0, 0.5})
+		{
+			row(9 + side, Eigen::Vector2d(rg * (nx + ny * t), rg * (ny - nx * t)),
+				nx != 0 ? band : 0.08, ny != 0 ? band : 0.08);
+			sum += A.row(9 + side);
+		}
+		A.row(9 + side) = sum / 3;
+	}
+	return A;
+}
+
+std::optional<BlurredCells> readCellsThroughBlur(
+	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
+	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
+	double sigma_px)
+{
+	using Vec = Eigen::Matrix<double, 13, 1>;
+	Vec m;
+	for (int i = 0; i < 9; ++i) m[i] = cell_g[i];
+	for (int i = 0; i < 4; ++i) m[9 + i] = ring_g[i];
+	const BoardShares A = blurredCellShares(map, geo, patch_fraction, sigma_px);
+	// Each code's green share at every patch, the black and green levels
+	// fitted by least squares (m = k0 + k1 f, k1 > 0); the least residual
+	// wins.
+	std::array<Vec, 256> fs;
+	int best = -1;
+	double best_sse = std::numeric_limits<double>::infinity(), k0 = 0, k1 = 0;
+	for (int code = 0; code < 256; ++code)
+	{
+		const CodeCells cells = cellsOfCode(code);
+		Vec f = A.col(9);
+		for (int j = 0; j < 9; ++j)
+			if (!cells[j / 3][j % 3]) f += A.col(j);
+		fs[code] = f;
+		const double fm = f.mean(), mm = m.mean();
+		const double sff = (f.array() - fm).square().sum();
+		if (!(sff > 1e-12)) continue;
+		const double b1 = ((f.array() - fm) * (m.array() - mm)).sum() / sff;
+		if (!(b1 > 0)) continue;
+		const double b0 = mm - b1 * fm;
+		const double sse = (m.array() - b0 - b1 * f.array()).square().sum();
+		if (sse < best_sse)
+		{
+			best = code;
+			best_sse = sse;
+			k0 = b0;
+			k1 = b1;
+		}
+	}
+	if (best < 0) return std::nullopt;
+	// The frame is the cells' ink, and the blur can only lighten it (its
+	// neighbours, the ring and the sheet, are lighter): a black level
+	// lighter than the frame reads takes a cell for black that is not.
+	if (k0 > frame_g + min_margin * k1) return std::nullopt;
+	// Each patch as the code and the blur predict it, within the threshold
+	// read's tolerance: a mean further from its prediction than that is not
+	// explained by the blur (a stain, glare, another print). The ring's
+	// patches pin the green level, the centre cell the black.
+	const Vec e = m - (k0 + k1 * fs[best].array()).matrix();
+	if (e.cwiseAbs().maxCoeff() > (0.5 - min_margin) * k1) return std::nullopt;
+	// Distance of the cell means to the boundary between the code read and
+	// each other code, along the line joining their cell means, against the
+	// distance between them: the thresholded read's margin rule.
+	BlurredCells out;
+	out.margin = std::numeric_limits<double>::infinity();
+	for (int code = 0; code < 256; ++code)
+	{
+		if (code == best) continue;
+		const Vec d = k1 * (fs[code] - fs[best]);
+		const double dn = d.norm();
+		if (!(dn > 1e-9)) return std::nullopt;
+		// ||e - d||^2 - ||e||^2 = dn^2 - 2 e.d; half of it over dn.
+		const double dist = (dn * dn - 2 * e.dot(d)) / (2 * dn);
+		if (dist < min_margin * dn) return std::nullopt;
+		out.margin = std::min(out.margin, dist);
+	}
+	out.cells = cellsOfCode(best);
+	return out;
+}
+
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& cam, const LandmarkGeometry& geo,
 	const CodeParams& p, double frame_blur_px)
@@ -186,7 +339,17 @@ std::optional<CodeReading> readCode(
 			r.cells[row][col] = *g < thr;
 			r.margin = std::min(r.margin, std::abs(*g - thr));
 		}
-	if (r.margin < p.min_margin * contrast) return std::nullopt;
+	// A cell near the threshold: a thin or distant board's cells blur into
+	// their neighbours, which a threshold between the frame's and the ring's
+	// levels does not know; read them again with the blur.
+	if (r.margin < p.min_margin * contrast)
+	{
+		const auto blurred = readCellsThroughBlur(
+			r.cell_g, green, r.black_g, map, geo, p.patch_fraction, p.min_margin, frame_blur_px);
+		if (!blurred) return std::nullopt;
+		r.cells = blurred->cells;
+		r.margin = blurred->margin;
+	}
 	// The frame and the black cells are the same ink: the frame's G must
 	// lie near the black cells' (the centre one at least), whatever the
 	// camera's transfer curve does to both.

@@ -589,9 +589,51 @@ struct FrameSurround
 FrameSurround frameSurround(
 	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo, int side, double blur_px);
 
+/** What each patch of readCode() reads of each part of the code board
+ * under a blur: rows 0-8 the cells' patches (row by row), rows 9-12 the
+ * green ring's patches along the top, right, bottom and left sides (each
+ * side's three averaged); columns 0-8 the cells, column 9 the ring between
+ * the board and the frame (the frame is black, the sheet beyond it out of
+ * reach). */
+using BoardShares = Eigen::Matrix<double, 13, 10>;
+
+/** The patches' mean shares of each part of the board (BoardShares) under
+ * a Gaussian blur of \a sigma_px [px, raw image], mapped into face
+ * coordinates through the local Jacobian of \a map at each patch (its
+ * skew ignored). */
+BoardShares blurredCellShares(
+	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double sigma_px);
+
+/** The cells read through the blur, where a thin or distant code board's
+ * cells blur into their neighbours (readCellsThroughBlur()). */
+struct BlurredCells
+{
+	CodeCells cells{};	//!< true = black
+	/** Smallest distance of the cell means to a decision boundary between
+	 * the code read and another [grey levels]; with no blur, the thresholded
+	 * read's margin. */
+	double margin = 0;
+};
+
+/** Reads the cells by comparing the cells' mean G (\a cell_g, row by row)
+ * and the ring's (\a ring_g, top, right, bottom, left) with every code's
+ * under a Gaussian blur of \a sigma_px (blurredCellShares(); black and
+ * green levels fitted by least squares): the code with the least squared
+ * residual wins. nullopt unless the black level is no lighter than the
+ * frame's G (\a frame_g) by more than \a min_margin of the contrast, each
+ * patch lies within (0.5 - \a min_margin) of the contrast of its
+ * prediction and each other code lies at least \a min_margin of its
+ * distance away from the read one: the thresholded read's rules, which
+ * this is when the blur vanishes. */
+std::optional<BlurredCells> readCellsThroughBlur(
+	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
+	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
+	double sigma_px);
+
 /** Checks the frame (inside the image, black on every side, green ring) and
  * reads the 3x3 cells; nullopt when any check fails, the centre cell is
- * green or a cell is ambiguous. */
+ * green or a cell is ambiguous. A cell too near the threshold is read again
+ * through the blur of \a frame_blur_px (readCellsThroughBlur()). */
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
 	const CodeParams& p, double frame_blur_px = ComponentParams().frame_blur_px);
