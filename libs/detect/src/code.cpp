@@ -43,14 +43,19 @@ std::optional<double> sampleG(const cv::Mat& bgr, double u, double v)
 	return (1 - fy) * top + fy * bot;
 }
 
+namespace
+{
+double normalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+}  // namespace
+
 double frameNeighbourShare(double width_px, double blur_px, double half_band)
 {
 	// Under two blur widths the dip's depth depends on the actual blur more
 	// than on the ink: no correction.
 	if (!(blur_px > 0) || !(width_px >= 2 * blur_px)) return 0;
-	const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
 	double share = 0;
-	for (int i = -2; i <= 2; ++i) share += phi(-(0.5 + half_band * i / 2.0) * width_px / blur_px);
+	for (int i = -2; i <= 2; ++i)
+		share += normalCdf(-(0.5 + half_band * i / 2.0) * width_px / blur_px);
 	return share / 5;
 }
 
@@ -104,40 +109,18 @@ std::optional<double> patchMean(
 		}
 	return s / 25;
 }
-}  // namespace
 
-namespace
-{
 /** Mean over 5 samples evenly spread over [c - r, c + r] of the Gaussian
  * (std \a s) blurred indicator of [a, b]. */
 double blurredInterval(double a, double b, double c, double r, double s)
 {
-	const auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
 	double sum = 0;
 	for (int k = -2; k <= 2; ++k)
 	{
 		const double x = c + r * k / 2.0;
-		sum += phi((b - x) / s) - phi((a - x) / s);
+		sum += normalCdf((b - x) / s) - normalCdf((a - x) / s);
 	}
 	return sum / 5;
-}
-
-/** A code's green indicator: 1 for each green cell (false in CodeCells). */
-CodeCells cellsOfCode(int code)
-{
-	// The centre is black; bits 0..7 fill the other eight cells row by row.
-	CodeCells cells{};
-	int bit = 0;
-	for (int k = 0; k < 9; ++k)
-	{
-		if (k == 4)
-		{
-			cells[1][1] = true;
-			continue;
-		}
-		cells[k / 3][k % 3] = ((code >> bit++) & 1) != 0;
-	}
-	return cells;
 }
 }  // namespace
 
@@ -199,7 +182,7 @@ std::optional<BlurredCells> readCellsThroughBlur(
 	for (int i = 0; i < 9; ++i) m[i] = cell_g[i];
 	for (int i = 0; i < 4; ++i) m[9 + i] = ring_g[i];
 	const BoardShares A = blurredCellShares(map, geo, patch_fraction, sigma_px);
-	// Each code's green share at every patch, the black and green levels
+	// Each ID's green share at every patch, the black and green levels
 	// fitted by least squares (m = k0 + k1 f, k1 > 0); the least residual
 	// wins.
 	std::array<Vec, 256> fs;
@@ -207,7 +190,7 @@ std::optional<BlurredCells> readCellsThroughBlur(
 	double best_sse = std::numeric_limits<double>::infinity(), k0 = 0, k1 = 0;
 	for (int code = 0; code < 256; ++code)
 	{
-		const CodeCells cells = cellsOfCode(code);
+		const CodeCells cells = encodeId(code);
 		Vec f = A.col(9);
 		for (int j = 0; j < 9; ++j)
 			if (!cells[j / 3][j % 3]) f += A.col(j);
@@ -254,7 +237,7 @@ std::optional<BlurredCells> readCellsThroughBlur(
 		if (dist < min_margin * dn) return std::nullopt;
 		out.margin = std::min(out.margin, dist);
 	}
-	out.cells = cellsOfCode(best);
+	out.cells = encodeId(best);
 	return out;
 }
 
