@@ -20,7 +20,9 @@ struct DetectionQuality
 	std::array<int, 4> line_support{{0, 0, 0, 0}};
 	/** Smallest margin between a code cell's mean intensity and the
 	 * black/green decision threshold, over the nine cells [grey levels,
-	 * 0..255]. Larger is safer. */
+	 * 0..255]; for cells read through the blur (docs/design.md, "Cells
+	 * through the blur"), the cells' smallest distance to the boundary with
+	 * another code. Larger is safer. */
 	double code_margin = 0;
 	/** Area of the reference square in the image [px^2]. */
 	double area_px = 0;
