@@ -110,6 +110,42 @@ std::optional<double> patchMean(
 	return s / 25;
 }
 
+/** A patch that readCode() averages: centre and half-sizes in normalised
+ * face coordinates. */
+struct FacePatch
+{
+	Eigen::Vector2d centre;
+	double rx = 0, ry = 0;
+};
+
+/** The patch of code cell \a i (row by row): its centre, a \a
+ * patch_fraction of the cell wide. */
+FacePatch cellPatch(const LandmarkGeometry& geo, int i, double patch_fraction)
+{
+	const double h = geo.innerHalf(), r = 0.5 * patch_fraction * geo.cell_size_m / h;
+	return {geo.cellCentreFace(i / 3, i % 3) / h, r, r};
+}
+
+/** Patch \a k (0..2, along the side's middle) of the green ring on side
+ * \a side (top, right, bottom, left): midway between the code board and
+ * the frame, half the ring wide across the side. */
+FacePatch ringPatch(const LandmarkGeometry& geo, int side, int k)
+{
+	const double board = 1.5 * geo.cell_size_m / geo.innerHalf();
+	const double rg = 0.5 * (board + 1), band = 0.25 * (1 - board);
+	const double t = -0.5 + 0.5 * k;
+	const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
+	// Along-side direction is (ny, -nx).
+	return {
+		Eigen::Vector2d(rg * (nx + ny * t), rg * (ny - nx * t)), nx != 0 ? band : 0.08,
+		ny != 0 ? band : 0.08};
+}
+
+std::optional<double> patchMean(const cv::Mat& bgr, const FaceMap& map, const FacePatch& f)
+{
+	return patchMean(bgr, map, f.centre.x(), f.centre.y(), f.rx, f.ry);
+}
+
 /** Mean over 5 samples evenly spread over [c - r, c + r] of the Gaussian
  * (std \a s) blurred indicator of [a, b]. */
 double blurredInterval(double a, double b, double c, double r, double s)
@@ -128,15 +164,15 @@ BoardShares blurredCellShares(
 	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double sigma_px)
 {
 	const double h = geo.innerHalf(), cell = geo.cell_size_m / h, board = 1.5 * cell;
-	const double pr = 0.5 * patch_fraction * cell;
 	BoardShares A;
-	// Row i: a patch centred on c, half-sizes rx, ry, 5 x 5 samples. The
+	// Row i: patch f (readCode()'s), 5 x 5 samples. The
 	// blur in face coordinates is sigma^2 (J^T J)^-1, J the map's Jacobian
 	// at the patch; its marginal standard deviations are used. The patch
 	// is a product grid: its mean of a blurred rectangle is the product of
 	// the means along each axis.
-	const auto row = [&](int i, const Eigen::Vector2d& c, double rx, double ry)
+	const auto row = [&](int i, const FacePatch& f)
 	{
+		const Eigen::Vector2d& c = f.centre;
 		const double e = 0.25 * cell;
 		Eigen::Matrix2d J;
 		J.col(0) = (map(c.x() + e, c.y()) - map(c.x() - e, c.y())) / (2 * e);
@@ -144,8 +180,10 @@ BoardShares blurredCellShares(
 		const Eigen::Matrix2d S = sigma_px * sigma_px * (J.transpose() * J).inverse();
 		const double sx = std::sqrt(std::max(S(0, 0), 1e-12)),
 					 sy = std::sqrt(std::max(S(1, 1), 1e-12));
-		const auto rect = [&](double x0, double x1, double y0, double y1)
-		{ return blurredInterval(x0, x1, c.x(), rx, sx) * blurredInterval(y0, y1, c.y(), ry, sy); };
+		const auto rect = [&](double x0, double x1, double y0, double y1) {
+			return blurredInterval(x0, x1, c.x(), f.rx, sx) *
+				   blurredInterval(y0, y1, c.y(), f.ry, sy);
+		};
 		for (int j = 0; j < 9; ++j)
 		{
 			const Eigen::Vector2d cj = geo.cellCentreFace(j / 3, j % 3) / h;
@@ -154,17 +192,14 @@ BoardShares blurredCellShares(
 		}
 		A(i, 9) = rect(-1, 1, -1, 1) - rect(-board, board, -board, board);
 	};
-	for (int i = 0; i < 9; ++i) row(i, geo.cellCentreFace(i / 3, i % 3) / h, pr, pr);
-	// The ring's patches of readCode(): three along each side's middle.
-	const double rg = 0.5 * (board + 1), band = 0.25 * (1 - board);
+	for (int i = 0; i < 9; ++i) row(i, cellPatch(geo, i, patch_fraction));
+	// The ring's patches: three along each side's middle, averaged.
 	for (int side = 0; side < 4; ++side)
 	{
-		const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
 		Eigen::Matrix<double, 1, 10> sum = Eigen::Matrix<double, 1, 10>::Zero();
-		for (const double t : {-0.5, 0.0, 0.5})
+		for (int k = 0; k < 3; ++k)
 		{
-			row(9 + side, Eigen::Vector2d(rg * (nx + ny * t), rg * (ny - nx * t)),
-				nx != 0 ? band : 0.08, ny != 0 ? band : 0.08);
+			row(9 + side, ringPatch(geo, side, k));
 			sum += A.row(9 + side);
 		}
 		A.row(9 + side) = sum / 3;
@@ -186,6 +221,7 @@ std::optional<BlurredCells> readCellsThroughBlur(
 	// fitted by least squares (m = k0 + k1 f, k1 > 0); the least residual
 	// wins.
 	std::array<Vec, 256> fs;
+	const double mm = m.mean();
 	int best = -1;
 	double best_sse = std::numeric_limits<double>::infinity(), k0 = 0, k1 = 0;
 	for (int code = 0; code < 256; ++code)
@@ -195,7 +231,7 @@ std::optional<BlurredCells> readCellsThroughBlur(
 		for (int j = 0; j < 9; ++j)
 			if (!cells[j / 3][j % 3]) f += A.col(j);
 		fs[code] = f;
-		const double fm = f.mean(), mm = m.mean();
+		const double fm = f.mean();
 		const double sff = (f.array() - fm).square().sum();
 		if (!(sff > 1e-12)) continue;
 		const double b1 = ((f.array() - fm) * (m.array() - mm)).sum() / sff;
@@ -264,9 +300,7 @@ std::optional<CodeReading> readCode(
 	// and the green ring between the code board and the frame, side by
 	// side (top, right, bottom, left).
 	const double rb = 0.5 * (1 + outer);
-	const double board = 1.5 * geo.cell_size_m / h;
-	const double rg = 0.5 * (board + 1);
-	const double band_b = 0.25 * (outer - 1), band_g = 0.25 * (1 - board);
+	const double band_b = 0.25 * (outer - 1);
 	// The frame's ink, without the fill and the sheet that blur spreads over
 	// it (frameNeighbourShare()): the level the ratio checks compare.
 	std::array<double, 4> black{}, green{}, ink{};
@@ -281,9 +315,8 @@ std::optional<CodeReading> readCode(
 			// Along-side direction is (ny, -nx).
 			const double ax = ny * t, ay = -nx * t;
 			const double rx_b = nx != 0 ? band_b : 0.08, ry_b = ny != 0 ? band_b : 0.08;
-			const double rx_g = nx != 0 ? band_g : 0.08, ry_g = ny != 0 ? band_g : 0.08;
 			const auto b = patchMean(bgr, map, nx * rb + ax, ny * rb + ay, rx_b, ry_b);
-			const auto g = patchMean(bgr, map, nx * rg + ax * rg, ny * rg + ay * rg, rx_g, ry_g);
+			const auto g = patchMean(bgr, map, ringPatch(geo, side, k));
 			if (!b || !g) return std::nullopt;
 			sb += *b;
 			sg += *g;
@@ -309,14 +342,11 @@ std::optional<CodeReading> readCode(
 			green[side] < r.black_g + 0.5 * contrast)
 			return std::nullopt;
 	const double thr = 0.5 * (r.green_g + r.black_g);
-	const double cell = geo.cell_size_m / h;
-	const double pr = 0.5 * p.patch_fraction * cell;
 	r.margin = contrast;
 	for (int row = 0; row < 3; ++row)
 		for (int col = 0; col < 3; ++col)
 		{
-			const Eigen::Vector2d f = geo.cellCentreFace(row, col) / h;
-			const auto g = patchMean(bgr, map, f.x(), f.y(), pr, pr);
+			const auto g = patchMean(bgr, map, cellPatch(geo, 3 * row + col, p.patch_fraction));
 			if (!g) return std::nullopt;
 			r.cell_g[3 * row + col] = *g;
 			r.cells[row][col] = *g < thr;
