@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -395,4 +396,25 @@ TEST(EdgeModels, LumaReadsWideSidesWhereTheChromaIsSubsampled)
 				}
 				EXPECT_LT(e, 0.03) << what;
 			}
+}
+
+// The slope the line fit's grey-level limit divides by: the profiles'
+// central difference at their located edges, the median over the side;
+// profiles without an edge do not count.
+TEST(EdgeModels, EdgeSlopeIsTheMedianResponseSlopeAtTheEdges)
+{
+	SideProfiles side;
+	side.n = 21;
+	std::vector<std::optional<double>> edges;
+	// Ramps of slope 5, 7, 7, 9 and 30 grey levels per sample about sample 10,
+	// then one without an edge (a steep one, which must not count).
+	for (const double s : {5.0, 7.0, 7.0, 9.0, 30.0, 100.0})
+	{
+		for (int i = 0; i < side.n; ++i)
+			side.g.push_back(static_cast<int>(std::clamp(40 + s * (i - 10), 10.0, 250.0)));
+		side.pos.push_back(static_cast<int>(side.pos.size()));
+		edges.emplace_back(s < 100 ? std::optional<double>(10.3) : std::nullopt);
+	}
+	EXPECT_DOUBLE_EQ(edgeSlope(side, edges), 7.0);
+	EXPECT_EQ(edgeSlope(side, std::vector<std::optional<double>>(6)), 0.0);
 }

@@ -1017,6 +1017,39 @@ TEST(Subpixel, LineFitRejectsOutliers)
 	EXPECT_FALSE(fitLine({pts.begin(), pts.begin() + 3}, SubpixelParams()));
 }
 
+// A side's points scattered block by block (a dim edge through JPEG's 8 x 8
+// blocks): refused at the pixel limit, kept where the scatter is within what
+// SubpixelParams::max_rms_grey on the side's response would cause, measured
+// along the line's normal.
+TEST(Subpixel, LineFitLimitFollowsTheEdgeResponse)
+{
+	const SubpixelParams p;
+	const auto staircase = [](double angle_deg)
+	{
+		const double a = angle_deg * M_PI / 180;
+		const Eigen::Vector2d along(std::cos(a), std::sin(a)), normal(-along.y(), along.x());
+		std::vector<Eigen::Vector2d> pts;
+		for (int i = 0; i < 48; ++i)
+			pts.push_back(Eigen::Vector2d(100, 100) + i * along + ((i / 8) % 2 ? 0.7 : -0.7) * normal);
+		return pts;
+	};
+	// Along the u axis, profiles along v: the response's slope is the normal's.
+	const auto level = staircase(0);
+	const auto f0 = fitLine(level, p);
+	EXPECT_FALSE(f0);
+	const auto f1 = fitLine(level, p, EdgeResponse{7, 1});	// 8 / 7 = 1.14 px
+	ASSERT_TRUE(f1);
+	EXPECT_NEAR(f1->rms_px, 0.7, 0.05);
+	EXPECT_NEAR(std::abs(f1->normal.dot(Eigen::Vector2d(120, 100)) + f1->c), 0, 0.15);
+	EXPECT_FALSE(fitLine(level, p, EdgeResponse{20, 1}));  // 0.4 px: the pixel limit
+	EXPECT_FALSE(fitLine(level, p, EdgeResponse{0, 1}));   // no response measured
+	// At 45 deg the profiles' slope is the normal's x cos 45 deg: 7 per
+	// sample is 9.9 per px along the normal (limit 0.81 px), 10 is 14.1 (0.57).
+	const auto oblique = staircase(45);
+	EXPECT_TRUE(fitLine(oblique, p, EdgeResponse{7, 1}));
+	EXPECT_FALSE(fitLine(oblique, p, EdgeResponse{10, 1}));
+}
+
 TEST(Subpixel, RefinedCornersOfACraftedLandmark)
 {
 	// The crafted fill is G = 255 without noise: as seen by the sensor, a

@@ -161,6 +161,19 @@ bool lumaIsSharper(
 	return m.median > kMinSharperZ * m.se && m.median >= kMinWiden * medianOf(green_width);
 }
 
+double edgeSlope(const SideProfiles& side, const std::vector<std::optional<double>>& edges)
+{
+	std::vector<double> slopes;
+	for (size_t j = 0; j < edges.size(); ++j)
+		if (edges[j])
+		{
+			const int k = static_cast<int>(std::lround(*edges[j]));
+			if (k >= 1 && k + 1 < side.n)
+				slopes.push_back(0.5 * std::abs(side.gAt(j)[k + 1] - side.gAt(j)[k - 1]));
+		}
+	return slopes.empty() ? 0.0 : medianOf(slopes);
+}
+
 SideProperties measureSide(const SideProfiles& side)
 {
 	const int half_count = static_cast<int>(side.count()) / 2;

@@ -169,6 +169,10 @@ std::unique_ptr<EdgeLocator> makeLocator(
 std::vector<std::optional<double>> locateEdges(
 	const SideProfiles& side, const EdgeLocator& locator);
 
+/** The median slope [grey levels per sample] of \a side's G profiles at
+ * their located \a edges (central differences); 0 where none is located. */
+double edgeSlope(const SideProfiles& side, const std::vector<std::optional<double>>& edges);
+
 /** The image points [undistorted px with \a camera's distortion] of the
  * located \a edges, for the line fit. */
 std::vector<Eigen::Vector2d> edgePoints(

@@ -114,6 +114,7 @@ void forEachField(Options& o, F&& f)
 	f("subpixel.min_outlier_px", o.subpixel.min_outlier_px);
 	f("subpixel.min_support", o.subpixel.min_support);
 	f("subpixel.max_rms_px", o.subpixel.max_rms_px);
+	f("subpixel.max_rms_grey", o.subpixel.max_rms_grey);
 	f("code.patch_fraction", o.code.patch_fraction);
 	f("code.min_contrast", o.code.min_contrast);
 	f("code.max_black_ratio", o.code.max_black_ratio);
@@ -180,6 +181,7 @@ void DetectorOptions::validate() const
 		"> 0");
 	require(p.min_support >= 3, "subpixel.min_support", ">= 3");
 	require(p.max_rms_px > 0, "subpixel.max_rms_px", "> 0");
+	require(p.max_rms_grey >= 0, "subpixel.max_rms_grey", ">= 0");
 	require(
 		code.patch_fraction > 0 && code.patch_fraction <= 1, "code.patch_fraction", "in (0, 1]");
 	require(code.min_contrast >= 0, "code.min_contrast", ">= 0");

@@ -472,9 +472,24 @@ struct LineFit
 	std::vector<Eigen::Vector2d> points;  //!< all edge points given (debug)
 };
 
+/** The edge response the points of a line fit were read on: its median
+ * slope across the profiles [grey levels per px] and the image axis the
+ * profiles run along (0 u, 1 v). */
+struct EdgeResponse
+{
+	double slope = 0;
+	int across = 0;
+};
+
 /** TLS fit with iterative outlier rejection (robust sigma from the median
- * absolute residual). Nullopt with fewer than min_support points kept. */
-std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> points, const SubpixelParams& p);
+ * absolute residual). Nullopt with fewer than min_support points kept or an
+ * RMS residual above SubpixelParams::max_rms_px, or, given the \a response
+ * the points were read on, above the larger of that and
+ * SubpixelParams::max_rms_grey over the response's slope along the line's
+ * normal. */
+std::optional<LineFit> fitLine(
+	std::vector<Eigen::Vector2d> points, const SubpixelParams& p,
+	const std::optional<EdgeResponse>& response = std::nullopt);
 
 /** The refined quadrangle. */
 struct RefinedQuad

@@ -487,7 +487,9 @@ bool fitTls(const std::vector<Eigen::Vector2d>& pts, const std::vector<char>& ke
 }
 }  // namespace
 
-std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelParams& p)
+std::optional<LineFit> fitLine(
+	std::vector<Eigen::Vector2d> pts, const SubpixelParams& p,
+	const std::optional<EdgeResponse>& response)
 {
 	LineFit f;
 	std::vector<char> keep(pts.size(), 1);
@@ -523,7 +525,13 @@ std::optional<LineFit> fitLine(std::vector<Eigen::Vector2d> pts, const SubpixelP
 			ss += e * e;
 		}
 	f.rms_px = std::sqrt(ss / f.support);
-	if (f.support < p.min_support || f.rms_px > p.max_rms_px) return std::nullopt;
+	// The profiles' slope is along their axis; along the normal it is
+	// steeper by 1 / |the normal's component on that axis|.
+	double max_rms = p.max_rms_px;
+	if (response && response->slope > 0)
+		max_rms = std::max(
+			max_rms, p.max_rms_grey * std::abs(f.normal[response->across]) / response->slope);
+	if (f.support < p.min_support || f.rms_px > max_rms) return std::nullopt;
 	f.points = std::move(pts);
 	return f;
 }
@@ -756,7 +764,12 @@ std::optional<RefinedQuad> refineQuadrangle(
 					return true;
 				}
 		}
-		auto f = fitLine(edgePoints(prof, edges, cam), p);
+		// G is the reference read: the grey-level allowance of the fit's
+		// limit is its own (luma above is taken only where it fits within
+		// the pixel limit).
+		auto f = fitLine(
+			edgePoints(prof, edges, cam), p,
+			EdgeResponse{edgeSlope(prof, edges), prof.across});
 		if (!f) return false;
 		out.sides[side] = std::move(*f);
 		return true;

@@ -194,6 +194,15 @@ struct SubpixelParams
 	int min_support = 5;
 	/** Largest RMS distance of the kept points to their line [px]. */
 	double max_rms_px = 0.6;
+	/** Largest RMS distance of the kept points to their line, as an error of
+	 * the edge's response [grey levels]: an error e on a response rising s
+	 * grey levels per px moves the edge by e / s, so a dim, low-contrast
+	 * side scatters beyond max_rms_px under the camera's coding alone
+	 * (JPEG's 8 x 8 blocks move its edge points block by block). A side's
+	 * limit is the larger of max_rms_px and max_rms_grey / its slope. 8: a
+	 * step of JPEG's luma quantiser at its lowest frequencies at quality 75
+	 * (16 x 0.5). */
+	double max_rms_grey = 8;
 };
 
 /** Stage 8: the code. Cells sampled through the homography of the corners,
