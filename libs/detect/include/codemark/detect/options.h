@@ -213,8 +213,13 @@ struct CodeParams
 	/** Each cell is averaged over a patch of this fraction of the cell size
 	 * (centred), sampled on a 5 x 5 grid. */
 	double patch_fraction = 0.4;
-	/** Smallest contrast G(green) - G(black) [grey levels]. */
-	double min_contrast = 20;
+	/** Smallest contrast G(green) - G(black) [grey levels]. No more than the
+	 * dimmest print the segmentation passes: an office green (sRGB (40, 170,
+	 * 80)) at SegmentationParams::min_intensity (12) reads G ~ 21, and its
+	 * black at up to 0.55 of that through a transfer curve leaves about 10.
+	 * The cells' margins (min_margin) and the black ratios judge the read
+	 * above it. */
+	double min_contrast = 10;
 	/** The frame's G (mean of its two darkest sides; each side's ink, the
 	 * blur's share of the fill and sheet removed as
 	 * ComponentParams::frame_blur_px says) must stay below this fraction of
