@@ -1245,7 +1245,7 @@ TEST(Code, ThroughBlurIsTheThresholdOnSharpCells)
 			m[k] = (cells[k / 3][k % 3] ? 30 : 200) + off(rng);
 			margin = std::min(margin, std::abs(m[k] - 115));
 		}
-		const auto r = readCellsThroughBlur(m, ring, 30, map, g, 0.4, 0.15, 1.5);
+		const auto r = readCellsThroughBlur(m, ring, 30, 30, map, g, 0.4, 0.15, 1.5);
 		ASSERT_TRUE(r) << id;
 		EXPECT_EQ(decodeCells(r->cells), id);
 		EXPECT_NEAR(r->margin, margin, 10) << id;
@@ -1255,7 +1255,28 @@ TEST(Code, ThroughBlurIsTheThresholdOnSharpCells)
 	const CodeCells cells = encodeId(0);
 	for (int k = 0; k < 9; ++k) m[k] = cells[k / 3][k % 3] ? 30 : 200;
 	m[0] = 115;
-	EXPECT_FALSE(readCellsThroughBlur(m, ring, 30, map, g, 0.4, 0.15, 1.5));
+	EXPECT_FALSE(readCellsThroughBlur(m, ring, 30, 30, map, g, 0.4, 0.15, 1.5));
+}
+
+// The frame and the cells are one ink: a dark print on green inside a grey
+// surround (a poster, a sticker on a wall) is not read as a code, though
+// its cells alone would make one.
+TEST(Code, ThroughBlurRefusesCellsOfAnotherInkThanTheFrame)
+{
+	const LandmarkGeometry g;
+	const CameraModel cam;
+	const FaceMap map{faceToImage(craftedCorners()), cam, false};
+	const std::array<double, 4> ring{220, 220, 220, 220};
+	const CodeCells cells = encodeId(192);
+	std::array<double, 9> m{};
+	for (int k = 0; k < 9; ++k) m[k] = cells[k / 3][k % 3] ? 40 : 220;
+	const auto same_ink = readCellsThroughBlur(m, ring, 40, 40, map, g, 0.4, 0.15, 1.5);
+	ASSERT_TRUE(same_ink);
+	EXPECT_EQ(decodeCells(same_ink->cells), 192);
+	// A grey surround at 130 (its ink as the frame's would be read).
+	EXPECT_FALSE(readCellsThroughBlur(m, ring, 130, 125, map, g, 0.4, 0.15, 1.5));
+	// Within the margin of the cells' black: still the same ink.
+	EXPECT_TRUE(readCellsThroughBlur(m, ring, 60, 60, map, g, 0.4, 0.15, 1.5));
 }
 
 TEST(Code, ReadsANarrowBlurredBoard)

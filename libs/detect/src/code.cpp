@@ -209,7 +209,7 @@ BoardShares blurredCellShares(
 
 std::optional<BlurredCells> readCellsThroughBlur(
 	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
-	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
+	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
 	double sigma_px)
 {
 	using Vec = Eigen::Matrix<double, 13, 1>;
@@ -251,6 +251,11 @@ std::optional<BlurredCells> readCellsThroughBlur(
 	// neighbours, the ring and the sheet, are lighter): a black level
 	// lighter than the frame reads takes a cell for black that is not.
 	if (k0 > frame_g + min_margin * k1) return std::nullopt;
+	// Nor is it darker than the frame's ink (its G without the blur's
+	// share of fill and sheet) by more: with the black fitted to the cells
+	// rather than set by the frame as the threshold read's, a dark print
+	// on green inside a grey surround would otherwise read as a code.
+	if (k0 < frame_ink - min_margin * k1) return std::nullopt;
 	// Each patch as the code and the blur predict it, within the threshold
 	// read's tolerance: a mean further from its prediction than that is not
 	// explained by the blur (a stain, glare, another print). The ring's
@@ -336,7 +341,8 @@ std::optional<CodeReading> readCode(
 	if (contrast < p.min_contrast) return std::nullopt;
 	std::array<double, 4> ink_sorted = ink;
 	std::sort(ink_sorted.begin(), ink_sorted.end());
-	if (0.5 * (ink_sorted[0] + ink_sorted[1]) > p.max_black_ratio * r.green_g) return std::nullopt;
+	const double frame_ink = 0.5 * (ink_sorted[0] + ink_sorted[1]);
+	if (frame_ink > p.max_black_ratio * r.green_g) return std::nullopt;
 	for (int side = 0; side < 4; ++side)
 		if (ink[side] > p.max_side_black_ratio * green[side] ||
 			green[side] < r.black_g + 0.5 * contrast)
@@ -358,7 +364,8 @@ std::optional<CodeReading> readCode(
 	if (r.margin < p.min_margin * contrast)
 	{
 		const auto blurred = readCellsThroughBlur(
-			r.cell_g, green, r.black_g, map, geo, p.patch_fraction, p.min_margin, frame_blur_px);
+			r.cell_g, green, r.black_g, frame_ink, map, geo, p.patch_fraction, p.min_margin,
+			frame_blur_px);
 		if (!blurred) return std::nullopt;
 		r.cells = blurred->cells;
 		r.margin = blurred->margin;

@@ -634,15 +634,17 @@ struct BlurredCells
  * and the ring's (\a ring_g, top, right, bottom, left) with every code's
  * under a Gaussian blur of \a sigma_px (blurredCellShares(); black and
  * green levels fitted by least squares): the code with the least squared
- * residual wins. nullopt unless the black level is no lighter than the
- * frame's G (\a frame_g) by more than \a min_margin of the contrast, each
- * patch lies within (0.5 - \a min_margin) of the contrast of its
- * prediction and each other code lies at least \a min_margin of its
- * distance away from the read one: the thresholded read's rules, which
- * this is when the blur vanishes. */
+ * residual wins. nullopt unless the black level is neither lighter than the
+ * frame's G (\a frame_g) nor darker than the frame's ink (\a frame_ink,
+ * the blur's share of fill and sheet removed) by more than \a min_margin
+ * of the contrast, each patch lies within (0.5 - \a min_margin) of the
+ * contrast of its prediction and each other code lies at least \a
+ * min_margin of its distance away from the read one: the thresholded
+ * read's rules, which this is when the blur vanishes and the cells' black
+ * is the frame's. */
 std::optional<BlurredCells> readCellsThroughBlur(
 	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
-	const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
+	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
 	double sigma_px);
 
 /** Checks the frame (inside the image, black on every side, green ring) and
