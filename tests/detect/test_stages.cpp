@@ -1030,7 +1030,8 @@ TEST(Subpixel, LineFitLimitFollowsTheEdgeResponse)
 		const Eigen::Vector2d along(std::cos(a), std::sin(a)), normal(-along.y(), along.x());
 		std::vector<Eigen::Vector2d> pts;
 		for (int i = 0; i < 48; ++i)
-			pts.push_back(Eigen::Vector2d(100, 100) + i * along + ((i / 8) % 2 ? 0.7 : -0.7) * normal);
+			pts.push_back(
+				Eigen::Vector2d(100, 100) + i * along + ((i / 8) % 2 ? 0.7 : -0.7) * normal);
 		return pts;
 	};
 	// Along the u axis, profiles along v: the response's slope is the normal's.
@@ -1042,7 +1043,7 @@ TEST(Subpixel, LineFitLimitFollowsTheEdgeResponse)
 	EXPECT_NEAR(f1->rms_px, 0.7, 0.05);
 	EXPECT_NEAR(std::abs(f1->normal.dot(Eigen::Vector2d(120, 100)) + f1->c), 0, 0.15);
 	EXPECT_FALSE(fitLine(level, p, EdgeResponse{20, 1}));  // 0.4 px: the pixel limit
-	EXPECT_FALSE(fitLine(level, p, EdgeResponse{0, 1}));   // no response measured
+	EXPECT_FALSE(fitLine(level, p, EdgeResponse{0, 1}));  // no response measured
 	// At 45 deg the profiles' slope is the normal's x cos 45 deg: 7 per
 	// sample is 9.9 per px along the normal (limit 0.81 px), 10 is 14.1 (0.57).
 	const auto oblique = staircase(45);

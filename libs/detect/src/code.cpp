@@ -209,8 +209,8 @@ BoardShares blurredCellShares(
 
 std::optional<BlurredCells> readCellsThroughBlur(
 	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
-	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
-	double sigma_px)
+	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction,
+	double min_margin, double sigma_px)
 {
 	using Vec = Eigen::Matrix<double, 13, 1>;
 	Vec m;

@@ -644,8 +644,8 @@ struct BlurredCells
  * is the frame's. */
 std::optional<BlurredCells> readCellsThroughBlur(
 	const std::array<double, 9>& cell_g, const std::array<double, 4>& ring_g, double frame_g,
-	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction, double min_margin,
-	double sigma_px);
+	double frame_ink, const FaceMap& map, const LandmarkGeometry& geo, double patch_fraction,
+	double min_margin, double sigma_px);
 
 /** Checks the frame (inside the image, black on every side, green ring) and
  * reads the 3x3 cells; nullopt when any check fails, the centre cell is

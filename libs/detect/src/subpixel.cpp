@@ -768,8 +768,7 @@ std::optional<RefinedQuad> refineQuadrangle(
 		// limit is its own (luma above is taken only where it fits within
 		// the pixel limit).
 		auto f = fitLine(
-			edgePoints(prof, edges, cam), p,
-			EdgeResponse{edgeSlope(prof, edges), prof.across});
+			edgePoints(prof, edges, cam), p, EdgeResponse{edgeSlope(prof, edges), prof.across});
 		if (!f) return false;
 		out.sides[side] = std::move(*f);
 		return true;
