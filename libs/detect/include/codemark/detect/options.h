@@ -24,9 +24,13 @@ struct SegmentationParams
 	 * filter of the grid's own size: every pixel is read once). When false,
 	 * only the block's top-left pixel is read. */
 	bool box_smoothing = false;
-	/** t_I: minimum HSI intensity I = (R + G + B) / 3 [grey levels, 0..255].
-	 * Low, so the fill at illumination gain 0.3 (G ~ 60) still passes. */
-	double min_intensity = 12;
+	/** t_I: minimum HSI intensity I = (R + G + B) / 3 of a pixel [grey
+	 * levels, 0..255]. A little under the dimmest fill the code reads
+	 * (CodeParams::min_contrast: an office green at I ~ 12), so that the fill
+	 * pixels next to the black frame, which the blur darkens, and the dim
+	 * half of a noisy fill still reach the frame, where the side selection
+	 * looks for the fill just inside each inner edge. */
+	double min_intensity = 10;
 	/** Green hue band [deg], HSI hue (hexcone approximation), green = 120.
 	 * Must lie within [60, 180] (green must be the largest channel). */
 	double hue_min_deg = 80;
@@ -214,9 +218,10 @@ struct CodeParams
 	 * (centred), sampled on a 5 x 5 grid. */
 	double patch_fraction = 0.4;
 	/** Smallest contrast G(green) - G(black) [grey levels]. No more than the
-	 * dimmest print the segmentation passes: an office green (sRGB (40, 170,
-	 * 80)) at SegmentationParams::min_intensity (12) reads G ~ 21, and its
-	 * black at up to 0.55 of that through a transfer curve leaves about 10.
+	 * dimmest print the code reads: an office green (sRGB (40, 170, 80)) at
+	 * I = 12, just above SegmentationParams::min_intensity, reads G ~ 21, and
+	 * its black at up to 0.55 of that through a transfer curve leaves about
+	 * 10.
 	 * The cells' margins (min_margin) and the black ratios judge the read
 	 * above it. */
 	double min_contrast = 10;
