@@ -28,6 +28,16 @@ void printStats(const char* what, const codemark::filters::InnovationSummary& s)
 		what, s.nis_mean, s.nis_dof, s.nis_dof > 0 ? s.nis_mean / s.nis_dof : 0.0, s.tested,
 		s.tested ? 100.0 * double(s.gated) / double(s.tested) : 0.0, 100.0 * s.sighting_share,
 		s.visits, s.visit_ratio, s.other_ratio);
+	// Per component: a component whose innovation is mostly the prediction's
+	// (a small sighting share; the bearing's on a wheel odometry) says little
+	// of the sightings' noise.
+	std::printf("          per component, mean NIS (sightings' share):");
+	for (size_t i = 0; i < 3; ++i)
+		if (std::isfinite(s.component_nis[i]))
+			std::printf(
+				" %s %.2f (%.0f%%)", codemark::filters::kInnovationComponents[i],
+				s.component_nis[i], 100.0 * s.component_share[i]);
+	std::printf("\n");
 }
 }  // namespace
 

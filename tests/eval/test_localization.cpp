@@ -202,6 +202,15 @@ TEST(Localize, EndToEndOnLandmarkObservationsWritesEveryOutput)
 		  "nees_band_95", "nis_mean", "nis_dof", "nis_count", "gated_fraction", "nis_verdict"})
 		EXPECT_TRUE(parsed.contains(k)) << k;
 	EXPECT_EQ(parsed["nees_band_95"].size(), 2u);
+	// Per component of L, by name, with the sighting's share of its variance.
+	for (size_t i = 0; i < 3; ++i)
+	{
+		const auto& c = parsed["nis_components"][kInnovationComponents[i]];
+		EXPECT_NEAR(c["nis"].get<double>(), s.nis_component_mean[i], 1e-4);
+		EXPECT_NEAR(c["sighting_share"].get<double>(), s.nis_component_share[i], 1e-4);
+		EXPECT_GT(s.nis_component_share[i], 0.0);
+		EXPECT_LE(s.nis_component_share[i], 1.0);
+	}
 	EXPECT_TRUE(parsed["calibration"].is_null()) << "no --calibration: stored covariances";
 	// With a calibration, summary.json names the file that measured.
 	LocalizeSummary with_cal;

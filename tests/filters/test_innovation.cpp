@@ -24,6 +24,16 @@ TEST(Innovation, NisAndLogDetMatchTheirDefinitions)
 	EXPECT_EQ(in.gated, in.nis > 16.27);
 	EXPECT_TRUE(makeInnovation(10 * nu, S, 1.0).gated);
 	EXPECT_TRUE(std::isnan(makeInnovation(nu, S, 16.27).sighting_share));
+	for (int i = 0; i < 3; ++i)
+	{
+		EXPECT_NEAR(in.component_nis[i], nu[i] * nu[i] / S(i, i), 1e-12) << i;
+		EXPECT_NEAR(in.component_share[i], 0.25, 1e-12) << i;
+	}
+	// A range-bearing sighting has two components; no R, no shares.
+	const Innovation rb = makeInnovation(Eigen::Vector2d(nu[0], nu[1]), S.topLeftCorner<2, 2>(), 9);
+	EXPECT_NEAR(rb.component_nis[1], nu[1] * nu[1] / S(1, 1), 1e-12);
+	EXPECT_TRUE(std::isnan(rb.component_nis[2]));
+	EXPECT_TRUE(std::isnan(rb.component_share[0]));
 }
 
 TEST(Innovation, NotPositiveDefiniteIsGatedWithInfiniteNis)
@@ -59,6 +69,9 @@ TEST(Innovation, VerdictOfDrawnInnovations)
 		EXPECT_EQ(s.nis_count, 2000);
 		EXPECT_NEAR(s.nis_dof, 3.0, 1e-12);
 		EXPECT_NEAR(s.nis_mean / s.nis_dof, 1.0 / k, 0.1 / k) << k;
+		// Each component alone says the same.
+		for (size_t i = 0; i < 3; ++i)
+			EXPECT_NEAR(s.nis_component_mean[i], 1.0 / k, 0.1 / k) << k << " component " << i;
 		if (k == 1.0)
 		{
 			EXPECT_EQ(s.nis_verdict, "consistent");

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 
 namespace fs = std::filesystem;
@@ -110,6 +111,29 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 				  << s0.nis_verdict << "), C_P/25 " << s_small.nis_mean / s_small.nis_dof << " ("
 				  << s_small.nis_verdict << "), C_P*9 " << s_large.nis_mean / s_large.nis_dof
 				  << " (" << s_large.nis_verdict << ")\n";
+		const auto& names = method == "ekf-pose" ? kPoseFixComponents : kInnovationComponents;
+		std::cout << "  per component, own / C_P*9 (sightings' share):";
+		for (size_t i = 0; i < 3; ++i)
+			std::cout << ' ' << names[i] << ' ' << s0.nis_component_mean[i] << " / "
+					  << s_large.nis_component_mean[i] << " (" << s0.nis_component_share[i] << ")";
+		std::cout << '\n';
+		// Per component: sightings 3x too wide lower the NIS of a component
+		// the sightings dominate, and hardly that of one the prediction
+		// dominates (L's bearing), which dilutes the mean.
+		for (size_t i = 0; i < 3; ++i)
+		{
+			const double share = s0.nis_component_share[i];
+			if (!std::isfinite(share)) continue;
+			const double ratio = s_large.nis_component_mean[i] / s0.nis_component_mean[i];
+			if (share >= 0.3)
+			{
+				EXPECT_LT(ratio, 0.6) << method << " seed " << seed << ' ' << names[i];
+			}
+			if (share < 0.01)
+			{
+				EXPECT_GT(ratio, 0.8) << method << " seed " << seed << ' ' << names[i];
+			}
+		}
 		EXPECT_GT(s0.nis_count, 50);
 		EXPECT_EQ(s0.nis_verdict, "consistent") << method << " seed " << seed;
 		EXPECT_TRUE(startsWith(s_small.nis_verdict, "covariances too small"))

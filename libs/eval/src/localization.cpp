@@ -417,6 +417,8 @@ void summariseInnovations(LocalizeSummary& s)
 	s.gated_fraction = n.tested ? double(n.gated) / double(n.tested) : 0.0;
 	s.nis_verdict = nisVerdict(s.nis_mean, s.nis_dof, s.nis_count);
 	s.nis_sighting_share = n.sighting_share;
+	s.nis_component_mean = n.component_nis;
+	s.nis_component_share = n.component_share;
 	s.nis_visits = n.visits;
 	s.nis_visit_ratio = n.visit_ratio;
 	s.persistent_errors = n.persistent_errors;
@@ -452,6 +454,16 @@ std::string summaryJson(const LocalizeSummary& s)
 	j["gated_fraction"] = num(s.gated_fraction, 4);
 	j["nis_verdict"] = s.nis_verdict;
 	j["nis_sighting_share"] = num(s.nis_sighting_share, 4);
+	// Per component, those it reports: which one reads off, and whether its
+	// innovation shows the sighting at all.
+	nlohmann::ordered_json components = nlohmann::ordered_json::object();
+	const auto& names = s.method == "ekf-pose" ? kPoseFixComponents : kInnovationComponents;
+	for (size_t i = 0; i < 3; ++i)
+		if (std::isfinite(s.nis_component_mean[i]))
+			components[names[i]] = {
+				{"nis", num(s.nis_component_mean[i], 4)},
+				{"sighting_share", num(s.nis_component_share[i], 4)}};
+	j["nis_components"] = components;
 	j["nis_visits"] = s.nis_visits;
 	j["nis_visit_ratio"] = num(s.nis_visit_ratio, 4);
 	j["persistent_errors"] = s.persistent_errors;

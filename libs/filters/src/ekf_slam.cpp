@@ -555,6 +555,8 @@ class SlamKF : public mrpt::bayes::CKalmanFilterCapable<3, D, D, 3>
 			const int dof = (D == 2 || s.point) ? 2 : 3;
 			Innovation in = makeInnovation(w, S, gateThreshold(opts.gate_probability, dof));
 			in.dof = dof;  // D = 3 with a point sighting: the third row is unused
+			// Its components are the whitened measurement's, not L's.
+			in.component_nis = Innovation::nanComponents();
 			in.id = s.id;
 			innovations.push_back(in);
 			if (in.gated)

@@ -5,6 +5,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -31,6 +33,11 @@ Innovation makeInnovation(
 	in.log_det_s = 2.0 * d.array().log().sum();
 	in.gated = !(in.nis <= gate);
 	if (R) in.sighting_share = llt.solve(*R).trace() / double(in.dof);
+	for (int i = 0; i < std::min(in.dof, 3); ++i)
+	{
+		in.component_nis[i] = nu[i] * nu[i] / S(i, i);
+		if (R) in.component_share[i] = (*R)(i, i) / S(i, i);
+	}
 	return in;
 }
 InnovationSummary summariseInnovations(const std::vector<const std::vector<Innovation>*>& steps)
@@ -38,6 +45,9 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 	InnovationSummary r;
 	double sum = 0, dof = 0, share = 0, visit_nis = 0, visit_dof = 0, other_nis = 0, other_dof = 0;
 	long shared = 0;
+	// Per component: sums and counts of its NIS and of its sighting share.
+	std::array<double, 3> c_nis{}, c_share{};
+	std::array<long, 3> n_nis{}, n_share{};
 	std::set<int> before;
 	for (const auto* step : steps)
 	{
@@ -57,6 +67,12 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 			dof += in.dof;
 			r.neg_log_likelihood += 0.5 * (in.log_det_s + in.nis);
 			if (std::isfinite(in.sighting_share)) share += in.sighting_share, ++shared;
+			for (size_t i = 0; i < 3; ++i)
+			{
+				if (std::isfinite(in.component_nis[i])) c_nis[i] += in.component_nis[i], ++n_nis[i];
+				if (std::isfinite(in.component_share[i]))
+					c_share[i] += in.component_share[i], ++n_share[i];
+			}
 			if (!before.count(in.id))
 				++r.visits, visit_nis += in.nis, visit_dof += in.dof;
 			else
@@ -68,6 +84,11 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 	r.nis_mean = sum / double(r.count);
 	r.nis_dof = dof / double(r.count);
 	if (shared) r.sighting_share = share / double(shared);
+	for (size_t i = 0; i < 3; ++i)
+	{
+		if (n_nis[i]) r.component_nis[i] = c_nis[i] / double(n_nis[i]);
+		if (n_share[i]) r.component_share[i] = c_share[i] / double(n_share[i]);
+	}
 	r.visit_ratio = visit_dof > 0 ? visit_nis / visit_dof : 0.0;
 	r.other_ratio = other_dof > 0 ? other_nis / other_dof : 0.0;
 	// Under "the visits' NIS have the others' scale", visit_nis / other_ratio

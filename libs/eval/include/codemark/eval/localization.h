@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -127,6 +128,11 @@ struct LocalizeSummary
 	/** Mean Innovation::sighting_share (NaN when the filter reports none):
 	 * how much the NIS can say about the sightings' covariances. */
 	double nis_sighting_share = std::numeric_limits<double>::quiet_NaN();
+	/** Per component of the innovation (filters::InnovationSummary): its
+	 * mean normalised squared innovation and the sighting's share of its
+	 * variance (NaN: not reported). */
+	std::array<double, 3> nis_component_mean = filters::Innovation::nanComponents();
+	std::array<double, 3> nis_component_share = filters::Innovation::nanComponents();
 	/** First sightings of a landmark visit, their mean NIS / DoF, and
 	 * whether it exceeds the others' beyond chance
 	 * (InnovationSummary::persistent_errors). */

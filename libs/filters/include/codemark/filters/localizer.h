@@ -13,6 +13,7 @@
 #include <mrpt/poses/CPose2D.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -50,7 +51,33 @@ struct Innovation
 	 * innovation shows the prediction's error and says little of R. NaN
 	 * when the filter does not report it. */
 	double sighting_share = std::numeric_limits<double>::quiet_NaN();
+	/** Each component's normalised squared innovation nu_i^2 / S_ii, in the
+	 * measurement's order (kInnovationComponents: range, bearing and, for L,
+	 * relative orientation; ekf-pose's pose fix: kPoseFixComponents; NaN
+	 * beyond dof, and where the filter tests the
+	 * innovation in another basis: EKF-SLAM whitens it): which of them reads
+	 * larger or smaller than predicted. Each averages 1 with honest
+	 * covariances. */
+	std::array<double, 3> component_nis = nanComponents();
+	/** The sighting's share of each component's variance, R_ii / S_ii (NaN
+	 * where the filter does not report R): near 0 that component's
+	 * innovation shows the prediction's error and says little of the
+	 * sighting's noise. */
+	std::array<double, 3> component_share = nanComponents();
+
+	static std::array<double, 3> nanComponents()
+	{
+		const double nan = std::numeric_limits<double>::quiet_NaN();
+		return {nan, nan, nan};
+	}
 };
+
+/** Names of the innovation's components (Innovation::component_nis): L =
+ * [l2 phi1 phi2] and a range-bearing sighting share the first two. */
+inline constexpr std::array<const char*, 3> kInnovationComponents = {
+	"range", "bearing", "orientation"};
+/** The same for the pose fix that ekf-pose fuses: the robot's map pose. */
+inline constexpr std::array<const char*, 3> kPoseFixComponents = {"x", "y", "yaw"};
 
 /** What one step did with the frame's sightings. */
 struct StepStats
@@ -93,6 +120,11 @@ struct InnovationSummary
 	double nis_mean = 0;  //!< mean NIS
 	double nis_dof = 0;	 //!< mean degrees of freedom
 	double sighting_share = std::numeric_limits<double>::quiet_NaN();  //!< mean sighting_share
+	/** Per component, the means of Innovation::component_nis and
+	 * Innovation::component_share over the sightings that have it (NaN:
+	 * none). */
+	std::array<double, 3> component_nis = Innovation::nanComponents();
+	std::array<double, 3> component_share = Innovation::nanComponents();
 	double neg_log_likelihood = 0;	//!< sum of (log det S + NIS) / 2 (infinite NIS: +inf)
 	long visits = 0;  //!< first sightings of a visit (finite NIS)
 	double visit_ratio = 0;	 //!< their mean NIS / DoF
