@@ -69,6 +69,15 @@ v = json.load(open(sys.argv[1])).get(sys.argv[2])
 print(", ".join(map(str, v)) if isinstance(v, list) else ("" if v is None else v))' "$1" "$2"
 }
 
+# summary.json's nis_components as "range / bearing / orientation", each
+# "NIS (share %)".
+components() {
+	python3 -c 'import json, sys
+c = json.load(open(sys.argv[1])).get("nis_components") or {}
+f = lambda v: "-" if v is None else "%.2f (%.0f%%)" % (v["nis"], 100 * (v["sighting_share"] or 0))
+print(" / ".join(f(c.get(k)) for k in ("range", "bearing", "orientation")))' "$1"
+}
+
 rows=()
 fit_rows=()
 run_set() { # name renderer preset
@@ -105,7 +114,7 @@ run_set() { # name renderer preset
 					-g "$dir/run$seed/gt_path.txt" --calibration "$c" -o "$out" >/dev/null
 				local s="$out/summary.json" band
 				band=$(json "$s" nees_band_95)
-				rows+=("| $name | $seed | $cal | $method | $(awk -v a="$(json "$s" ate_rmse_m)" 'BEGIN{printf "%.2f", 100*a}') | $(awk -v a="$(json "$s" nees_mean)" 'BEGIN{printf "%.2f", a}') [${band/, /, }] | $(awk -v a="$(json "$s" nis_mean)" -v d="$(json "$s" nis_dof)" 'BEGIN{printf "%.2f", a/d}') | $(awk -v a="$(json "$s" nis_visit_ratio)" 'BEGIN{printf "%.2f", a}') | $(json "$s" nis_verdict) | $(awk -v a="$(json "$s" gated_fraction)" 'BEGIN{printf "%.1f", 100*a}') |")
+				rows+=("| $name | $seed | $cal | $method | $(awk -v a="$(json "$s" ate_rmse_m)" 'BEGIN{printf "%.2f", 100*a}') | $(awk -v a="$(json "$s" nees_mean)" 'BEGIN{printf "%.2f", a}') [${band/, /, }] | $(awk -v a="$(json "$s" nis_mean)" -v d="$(json "$s" nis_dof)" 'BEGIN{printf "%.2f", a/d}') | $(awk -v a="$(json "$s" nis_visit_ratio)" 'BEGIN{printf "%.2f", a}') | $(components "$s") | $(json "$s" nis_verdict) | $(awk -v a="$(json "$s" gated_fraction)" 'BEGIN{printf "%.1f", 100*a}') |")
 			done
 		done
 	done
@@ -202,10 +211,13 @@ mkdir -p "$(dirname "$DOC")"
 	echo "ATE: RMS position error. NEES: mean over the run with its two-sided 95% band."
 	echo "NIS/DoF: mean NIS over its degrees of freedom (consistent in [0.5, 2]); visits: the"
 	echo "same over the first sightings of each landmark visit, which carry the sightings'"
-	echo "errors that persist from frame to frame (docs/calibration.md)."
+	echo "errors that persist from frame to frame (docs/calibration.md). Per component:"
+	echo "the mean NIS of the range, the bearing and the relative orientation, each with"
+	echo "the sightings' share of its variance (a component with a small share shows the"
+	echo "prediction's error, not the sightings')."
 	echo
-	echo "| dataset | run | calibration | method | ATE [cm] | NEES [95% band] | NIS/DoF | visits | verdict | gated [%] |"
-	echo "|---|---|---|---|---|---|---|---|---|---|"
+	echo "| dataset | run | calibration | method | ATE [cm] | NEES [95% band] | NIS/DoF | visits | per component: range / bearing / orientation | verdict | gated [%] |"
+	echo "|---|---|---|---|---|---|---|---|---|---|---|"
 	printf '%s\n' "${rows[@]}"
 	echo
 	echo "## The verdict over $SEEDS seeds"
