@@ -54,10 +54,9 @@ struct Innovation
 	/** Each component's normalised squared innovation nu_i^2 / S_ii, in the
 	 * measurement's order (kInnovationComponents: range, bearing and, for L,
 	 * relative orientation; ekf-pose's pose fix: kPoseFixComponents; NaN
-	 * beyond dof, and where the filter tests the
-	 * innovation in another basis: EKF-SLAM whitens it): which of them reads
-	 * larger or smaller than predicted. Each averages 1 with honest
-	 * covariances. */
+	 * beyond dof, and where the filter tests the innovation in another
+	 * basis: EKF-SLAM whitens it): which of them reads larger or smaller than
+	 * predicted. Each averages 1 with honest covariances. */
 	std::array<double, 3> component_nis = nanComponents();
 	/** The sighting's share of each component's variance, R_ii / S_ii (NaN
 	 * where the filter does not report R): near 0 that component's
