@@ -111,7 +111,7 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 				  << s0.nis_verdict << "), C_P/25 " << s_small.nis_mean / s_small.nis_dof << " ("
 				  << s_small.nis_verdict << "), C_P*9 " << s_large.nis_mean / s_large.nis_dof
 				  << " (" << s_large.nis_verdict << ")\n";
-		const auto& names = method == "ekf-pose" ? kPoseFixComponents : kInnovationComponents;
+		const auto& names = innovationComponentNames(method);
 		std::cout << "  per component, own / C_P*9 (sightings' share):";
 		for (size_t i = 0; i < 3; ++i)
 			std::cout << ' ' << names[i] << ' ' << s0.nis_component_mean[i] << " / "

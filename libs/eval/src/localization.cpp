@@ -457,7 +457,7 @@ std::string summaryJson(const LocalizeSummary& s)
 	// Per component, those it reports: which one reads off, and whether its
 	// innovation shows the sighting at all.
 	nlohmann::ordered_json components = nlohmann::ordered_json::object();
-	const auto& names = s.method == "ekf-pose" ? kPoseFixComponents : kInnovationComponents;
+	const auto& names = innovationComponentNames(s.method);
 	for (size_t i = 0; i < 3; ++i)
 		if (std::isfinite(s.nis_component_mean[i]))
 			components[names[i]] = {

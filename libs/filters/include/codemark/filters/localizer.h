@@ -77,6 +77,11 @@ inline constexpr std::array<const char*, 3> kInnovationComponents = {
 	"range", "bearing", "orientation"};
 /** The same for the pose fix that ekf-pose fuses: the robot's map pose. */
 inline constexpr std::array<const char*, 3> kPoseFixComponents = {"x", "y", "yaw"};
+/** The component names of \a method's innovations (Localizer::method()). */
+inline const std::array<const char*, 3>& innovationComponentNames(const std::string& method)
+{
+	return method == "ekf-pose" ? kPoseFixComponents : kInnovationComponents;
+}
 
 /** What one step did with the frame's sightings. */
 struct StepStats
