@@ -29,6 +29,7 @@
 #include <fstream>
 #include <iostream>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -60,6 +61,7 @@ struct Sample
 	double aligned_weight = 0;
 	double rows_top = 0, rows_bottom = 0;  // rows between the top and bottom edges' ends [px]
 	double image_noise = 0;	 // DetectionQuality::image_noise_grey (0: not measured)
+	double bend = 0, bend_se = 0;  // DetectionQuality::edge_bend_px, edge_bend_se_px
 	int group = 0;	// --vary-scene: print (i % 3) + 3 * light
 	Eigen::Vector4d P_true = Eigen::Vector4d::Zero();
 	/** Clipped sides on x1, x2 (left, right: 0 or 1) and on y1, y2 (top and bottom: 0-2). */
@@ -179,8 +181,10 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> preset_arg(
 			"", "preset",
 			"Camera preset of the renders (docs/camera-pipeline.md), applied after --realistic "
-			"and before --render-config.",
-			false, "", "NAME", cmd);
+			"and before --render-config; several, comma-separated (e.g. "
+			"linear,webcam,phone,family): --renders each, at poses of their own, fitted "
+			"together, so that no one camera's errors set the model.",
+			false, "", "NAME[,NAME...]", cmd);
 		TCLAP::ValueArg<std::string> render_arg(
 			"", "render-config",
 			"Ini file whose [render] section overrides the render options (after --realistic), "
@@ -249,27 +253,45 @@ int main(int argc, char** argv)
 		ro.noise_sigma = 2;
 		ro.blur_sigma_px = 0.8;
 		if (realistic_arg.getValue()) ro = sim::DatasetOptions::realisticRender();
-		if (preset_arg.isSet()) ro.applyPreset(preset_arg.getValue());
-		if (!render_arg.getValue().empty())
+		std::vector<std::string> presets;
 		{
-			// MRPT reads a missing file as an empty one: say so instead.
-			const std::string& path = render_arg.getValue();
-			if (!std::ifstream(path).good())
-				throw std::runtime_error(path + ": cannot open the render options file");
-			const mrpt::config::CConfigFile ini(path);
-			if (!ini.sectionExists("render"))
-				throw std::runtime_error(path + ": no [render] section");
-			ro.loadFromConfigFile(ini, "render");
+			std::stringstream list(preset_arg.getValue());
+			for (std::string name; std::getline(list, name, ',');)
+				if (!name.empty()) presets.push_back(name);
 		}
+		if (presets.empty()) presets.emplace_back();
+		if (presets.size() > 1 && noise_split_arg.getValue() > 0)
+			throw std::invalid_argument("--noise-split takes one --preset");
+		// The render options per preset.
+		std::vector<sim::RenderOptions> ro_presets;
+		for (const auto& name : presets)
+		{
+			sim::RenderOptions r = ro;
+			if (!name.empty()) r.applyPreset(name);
+			if (!render_arg.getValue().empty())
+			{
+				// MRPT reads a missing file as an empty one: say so instead.
+				const std::string& path = render_arg.getValue();
+				if (!std::ifstream(path).good())
+					throw std::runtime_error(path + ": cannot open the render options file");
+				const mrpt::config::CConfigFile ini(path);
+				if (!ini.sectionExists("render"))
+					throw std::runtime_error(path + ": no [render] section");
+				r.loadFromConfigFile(ini, "render");
+			}
+			ro_presets.push_back(r);
+		}
+		ro = ro_presets.front();
 		const LandmarkGeometry g = lm.geometry();
 		const detect::DetectorOptions dopt =
 			detector_arg.getValue().empty()
 				? detect::DetectorOptions()
 				: detect::DetectorOptions::load(detector_arg.getValue());
-		// The renders at \a r (the same poses and noise seeds for any r).
-		const auto collect = [&](const sim::RenderOptions& r, int& missed)
+		// The renders at \a r (the same poses and noise seeds for any r of
+		// one \a seed).
+		const auto collect = [&](const sim::RenderOptions& r, int& missed, uint64_t seed)
 		{
-			std::mt19937_64 rng(seed_arg.getValue());
+			std::mt19937_64 rng(seed);
 			std::uniform_real_distribution<double> U(0, 1);
 			std::vector<Sample> samples;
 			missed = 0;
@@ -303,7 +325,7 @@ int main(int argc, char** argv)
 						ri.gradient_angle_rad = std::fmod(0.7 * i, 2 * M_PI);
 					}
 				}
-				const sim::Render img = renderer(scene, ri, seed_arg.getValue() * 100003 + i);
+				const sim::Render img = renderer(scene, ri, seed * 100003 + i);
 				if (!img.truth[0].fully_visible) continue;
 				const auto res = detect::detect(img.image, scene.camera, g, dopt);
 				bool found = false;
@@ -325,6 +347,8 @@ int main(int argc, char** argv)
 						s.line_support = dl.detection.quality.line_support;
 						s.code_margin = dl.detection.quality.code_margin;
 						s.image_noise = dl.detection.quality.image_noise_grey;
+						s.bend = dl.detection.quality.edge_bend_px;
+						s.bend_se = dl.detection.quality.edge_bend_se_px;
 						s.group = i % 12;
 						const auto& tc = img.truth[0].corners_px;
 						s.P_true = img.truth[0].P;
@@ -341,14 +365,22 @@ int main(int argc, char** argv)
 			return samples;
 		};
 		int missed = 0;
-		const std::vector<Sample> samples = collect(ro, missed);
+		std::vector<Sample> samples;
+		for (size_t k = 0; k < ro_presets.size(); ++k)
+		{
+			int m = 0;
+			// Poses of its own per preset (the first keeps --seed's).
+			const auto v = collect(ro_presets[k], m, seed_arg.getValue() + 7919 * k);
+			samples.insert(samples.end(), v.begin(), v.end());
+			missed += m;
+		}
 		if (!csv_arg.getValue().empty())
 		{
 			std::ofstream f(csv_arg.getValue());
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
 				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
 				 "clipped_left,rms_top,rms_right,rms_bottom,rms_left,image_noise,group,support_top,"
-				 "support_right,support_bottom,support_left,code_margin\n";
+				 "support_right,support_bottom,support_left,code_margin,bend,bend_se\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
@@ -358,7 +390,7 @@ int main(int argc, char** argv)
 				for (int k = 0; k < 4; ++k) f << "," << s.line_rms[k];
 				f << "," << s.image_noise << "," << s.group;
 				for (int k = 0; k < 4; ++k) f << "," << s.line_support[k];
-				f << "," << s.code_margin << "\n";
+				f << "," << s.code_margin << "," << s.bend << "," << s.bend_se << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);
@@ -686,6 +718,93 @@ int main(int argc, char** argv)
 				fitted.corner_tilt_ratio = std::sqrt(z1.tilt);
 				fitted.corner_tilt_ratio_table = tt;
 			}
+			// The scatter model (PoseOptions::band_ratio_x): on the
+			// detections whose bands the detector measured, var = (K se)^2 +
+			// floor(size)^2 with the table's clipped and aligned terms; K by
+			// maximum likelihood on a grid, the floor per size bin given K
+			// (bins of at least 150 detections: a floor is a small
+			// difference of two variances, noisy on fewer).
+			{
+				std::vector<Sample> banded;
+				for (const auto& sm : samples)
+					if (sm.bend_se > 0) banded.push_back(sm);
+				if (banded.size() >= 100 && !averaged_arg.getValue())
+				{
+					const auto bandFit = [&](bool x, double& ratio)
+					{
+						double best_total = 1e300;
+						pose::SigmaTable best_table;
+						const auto bins = sizeBins(
+							banded, [&](const Sample& sm) { return sizeOf(sm, x); }, 150);
+						for (int i = 1; i <= 120; ++i)
+						{
+							const double k = 0.1 * i;
+							double total = 0;
+							pose::SigmaTable t;
+							for (const SizeBin& bin : bins)
+							{
+								double best = 1e300, best_floor = 0;
+								for (int g = 0; g <= 200; ++g)
+								{
+									// 0, then 0.001 to 1 px.
+									const double fl =
+										g == 0 ? 0.0 : 1e-3 * std::pow(1e3, g / 200.0);
+									double nll = 0;
+									for (const Sample* sm : bin.samples)
+										for (const int c : {x ? 0 : 1, x ? 2 : 3})
+										{
+											const double v =
+												(k * k * sm->bend_se * sm->bend_se + fl * fl) *
+													(1 + aligned(*sm, c)) +
+												share(*sm, c);
+											nll += sm->e_P[c] * sm->e_P[c] / v + std::log(v);
+										}
+									if (nll < best)
+									{
+										best = nll;
+										best_floor = fl;
+									}
+								}
+								total += best;
+								// A table holds sigmas > 0: 0.1 mpx stands for none.
+								const double f = std::max(1e-4, best_floor);
+								const double p10 = std::pow(10, std::floor(std::log10(f)) - 2);
+								if (t.empty() || bin.size_px > t.back().first)
+									t.emplace_back(bin.size_px, std::round(f / p10) * p10);
+							}
+							if (total < best_total)
+							{
+								best_total = total;
+								best_table = t;
+								ratio = k;
+							}
+						}
+						return best_table;
+					};
+					double kx = 0, ky = 0;
+					const pose::SigmaTable fx_t = bandFit(true, kx), fy_t = bandFit(false, ky);
+					const auto bandVar = [&](const Sample& sm, int c)
+					{
+						const bool x = c % 2 == 0;
+						const double k = x ? kx : ky,
+									 f = pose::interpolateSigma(x ? fx_t : fy_t, sizeOf(sm, x));
+						return (k * k * sm.bend_se * sm.bend_se + f * f) * (1 + aligned(sm, c)) +
+							   share(sm, c);
+					};
+					const Normalised zb = normalised(banded, bandVar);
+					std::printf(
+						"scatter model (%zu of %zu detections with bands measured):\n"
+						"  band_ratio_x = %.1f\n  band_ratio_y = %.1f\n"
+						"  band_floor_x_table = %s\n  band_floor_y_table = %s\n"
+						"  normalised variance x %.3f y %.3f midpoint %.3f tilt %.3f\n",
+						banded.size(), samples.size(), kx, ky, pose::toString(fx_t).c_str(),
+						pose::toString(fy_t).c_str(), zb.x, zb.y, zb.midpoint, zb.tilt);
+					fitted.band_ratio_x = kx;
+					fitted.band_ratio_y = ky;
+					fitted.band_floor_x_table = fx_t;
+					fitted.band_floor_y_table = fy_t;
+				}
+			}
 			// The one ratio where no bin gives one (exact renders: no tilt error).
 			const auto tiltRatio2 = [&](const Sample& sm)
 			{ return tt.empty() ? z1.tilt : std::pow(pose::interpolateSigma(tt, sm.side_px), 2); };
@@ -697,7 +816,7 @@ int main(int argc, char** argv)
 					throw std::invalid_argument(
 						"--noise-split needs renders with noise and a different second noise");
 				int missed2 = 0;
-				const std::vector<Sample> second = collect(r2, missed2);
+				const std::vector<Sample> second = collect(r2, missed2, seed_arg.getValue());
 				// The noise as the detector measures it (its estimator's own
 				// bias then cancels): the reference is the mean measured on
 				// the calibration renders, the ratio that of the two passes.
@@ -889,14 +1008,15 @@ int main(int argc, char** argv)
 				char data[400];
 				std::snprintf(
 					data, sizeof data,
-					"data: %s renderer, %s, camera preset %s, %d renders at %.1f-%.1f m, "
-					"view angles up to %.0f deg; %zu detections, %d missed",
+					"data: %s renderer, %s, camera preset%s %s, %d renders at %.1f-%.1f m, "
+					"view angles up to %.0f deg each; %zu detections, %d missed",
 					renderer_arg.getValue().c_str(),
 					realistic_arg.getValue()
 						? (vary_arg.getValue()
 							   ? "realistic scene (textured wall) with prints and lights varied"
 							   : "realistic scene (textured wall, light gradient)")
 						: "plain background scene",
+					presets.size() > 1 ? "s" : "",
 					preset_arg.getValue().empty() ? "none" : preset_arg.getValue().c_str(),
 					n_arg.getValue(), dmin_arg.getValue(), dmax_arg.getValue(), amax_arg.getValue(),
 					samples.size(), missed);

@@ -601,6 +601,48 @@ TEST(Renders, BandMidlineUndoesTheTransferCurvesBend)
 		}
 }
 
+// DetectionQuality::edge_bend_px and edge_bend_se_px, which the scatter
+// model of C_P reads (pose::PoseOptions::band_ratio_x): the bend is about 0
+// in linear light and a few tenths of a pixel outwards through a transfer
+// curve; its standard error is measured wherever the bands are, and grows
+// with the image's noise.
+TEST(Renders, EdgeBendAndItsScatterAreMeasured)
+{
+	using sim::Transfer;
+	for (const Transfer curve : {Transfer::Linear, Transfer::SRGB})
+	{
+		double se_sum[2] = {0, 0};
+		for (const int noisy : {0, 1})
+		{
+			int n = 0;
+			for (const double dist : {1.0, 2.0})
+				for (const double angle : {0.0, 30.0})
+					for (int k = 0; k < 2; ++k, ++n)
+					{
+						auto o = nominalRender();
+						o.transfer = curve;
+						o.noise_sigma = noisy ? 6 : 1;
+						const Shot s = shoot(
+							(n * 29 + 5) % 256, dist, angle * kDeg, o, 1500 + n, 0.03 * (k - 1));
+						const auto r = run(s.render.image);
+						std::ostringstream what;
+						what << "curve " << static_cast<int>(curve) << " noise " << o.noise_sigma
+							 << " at " << dist << " m, " << angle << " deg";
+						ASSERT_EQ(r.landmarks.size(), 1u) << what.str();
+						const auto& q = r.landmarks[0].detection.quality;
+						EXPECT_GT(q.edge_bend_se_px, 0) << what.str();
+						EXPECT_LT(q.edge_bend_se_px, 0.1) << what.str();
+						if (!noisy && curve == Transfer::Linear)
+							EXPECT_LT(std::abs(q.edge_bend_px), 0.08) << what.str();
+						if (!noisy && curve == Transfer::SRGB)
+							EXPECT_GT(q.edge_bend_px, 0.15) << what.str();
+						se_sum[noisy] += q.edge_bend_se_px;
+					}
+		}
+		EXPECT_GT(se_sum[1], 1.5 * se_sum[0]) << static_cast<int>(curve);
+	}
+}
+
 namespace
 {
 /** P of the one landmark in a committed POV-Ray frame's truth.jsonl. */

@@ -81,6 +81,8 @@ void expectSame(const CObservationCodedLandmarks& a, const CObservationCodedLand
 		EXPECT_EQ(x.quality.corner_sigma_px, y.quality.corner_sigma_px);
 		EXPECT_EQ(x.quality.fill_clipped, y.quality.fill_clipped);
 		EXPECT_EQ(x.quality.image_noise_grey, y.quality.image_noise_grey);
+		EXPECT_EQ(x.quality.edge_bend_px, y.quality.edge_bend_px);
+		EXPECT_EQ(x.quality.edge_bend_se_px, y.quality.edge_bend_se_px);
 		EXPECT_EQ(x.method, y.method);
 	}
 }
@@ -148,6 +150,24 @@ TEST(CodedLandmarksObs, ImageNoiseRoundTrip)
 	expectSame(o, *back);
 	// A negative noise is corrupt data, not a measurement.
 	o.sightings[1].quality.image_noise_grey = -1;
+	EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)));
+}
+
+TEST(CodedLandmarksObs, EdgeBendRoundTrip)
+{
+	// Version 3's edge bend and its standard error (older versions read
+	// them as 0, not measured).
+	auto o = makeFilled();
+	o.sightings[0].quality.edge_bend_px = 0.25;
+	o.sightings[0].quality.edge_bend_se_px = 0.03125;
+	o.sightings[1].quality.edge_bend_px = -0.125;
+	o.sightings[1].quality.edge_bend_se_px = 0.0078125;
+	const auto back = std::dynamic_pointer_cast<CObservationCodedLandmarks>(
+		codemark::test::fromBytes(codemark::test::toBytes(o)));
+	ASSERT_TRUE(back);
+	expectSame(o, *back);
+	// A negative standard error is corrupt data.
+	o.sightings[1].quality.edge_bend_se_px = -0.5;
 	EXPECT_ANY_THROW(codemark::test::fromBytes(codemark::test::toBytes(o)));
 }
 

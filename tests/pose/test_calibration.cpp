@@ -53,6 +53,10 @@ PoseOptions fullModel()
 	o.corner_tilt_ratio = 0.34;
 	o.corner_tilt_ratio_table = {{28.7, 0.31}, {150.2, 0.82}};
 	o.corner_tilt_noise_ratio = 0.96;
+	o.band_ratio_x = 4.5;
+	o.band_ratio_y = 3.9;
+	o.band_floor_x_table = {{14.2, 0.061}, {60.5, 0.0123}};
+	o.band_floor_y_table = {{22.8, 0.0405}};
 	return o;
 }
 
@@ -117,9 +121,13 @@ TEST(Calibration, WrittenFileReadsBackExactly)
 	EXPECT_EQ(a.noise_sigma_y_table, b.noise_sigma_y_table);
 	EXPECT_EQ(a.corner_tilt_ratio_table, b.corner_tilt_ratio_table);
 	EXPECT_EQ(a.corner_tilt_noise_ratio, b.corner_tilt_noise_ratio);
-	// The same C_P everywhere, clipped sides and noise scaling included.
+	EXPECT_EQ(a.band_ratio_y, b.band_ratio_y);
+	EXPECT_EQ(a.band_floor_x_table, b.band_floor_x_table);
+	// The same C_P everywhere, clipped sides, noise scaling and the bands'
+	// scatter included.
 	const Eigen::Vector4d P(-40, 30, 45, 33);
 	EXPECT_EQ(a.primaryCovariance(P, 5.0), b.primaryCovariance(P, 5.0));
+	EXPECT_EQ(a.primaryCovariance(P, 5.0, 0.02), b.primaryCovariance(P, 5.0, 0.02));
 	EXPECT_EQ(
 		a.clippedSidesCovariance({true, false, true, true}),
 		b.clippedSidesCovariance({true, false, true, true}));
@@ -203,6 +211,8 @@ TEST(Calibration, BadFilesAreRefusedWithFileLineAndKey)
 		{variant("sigma_x_table", "10:0.1 5:0.2"),
 		 ":[0-9]+: sigma_x_table = .*sizes must increase"},
 		{variant("noise_sigma_y_table", "10:-1"), ":[0-9]+: noise_sigma_y_table = .*bad entry"},
+		{variant("band_ratio_x", "-2"), ":[0-9]+: band_ratio_x = '-2': must be >= 0"},
+		{variant("band_floor_y_table", "20:0 30:0.1"), ":[0-9]+: band_floor_y_table = .*bad entry"},
 		{variant("", "", "sigma_px = 0.1\n"), ":[0-9]+: key 'sigma_px' set twice"},
 		{"[other]\nsigma_px = 1\n", "no \\[pose\\] section"},
 	};
@@ -213,6 +223,32 @@ TEST(Calibration, BadFilesAreRefusedWithFileLineAndKey)
 		EXPECT_NE(what.find("codemark-test-calibration-"), std::string::npos) << what;
 	}
 	EXPECT_THROW(loadCalibration("/nonexistent/calibration.ini"), std::runtime_error);
+}
+
+// The scatter model's keys came later than the format: a file without them
+// (every calibration written before) loads, with the model off.
+TEST(Calibration, FileWithoutTheScatterModelLoadsWithItOff)
+{
+	std::string text = variant("band_ratio_x", "<drop>");
+	for (const char* key : {"band_ratio_y", "band_floor_x_table", "band_floor_y_table"})
+	{
+		const auto at = text.find(std::string(key) + " =");
+		ASSERT_NE(at, std::string::npos) << key;
+		text.erase(at, text.find('\n', at) - at + 1);
+	}
+	ASSERT_EQ(refusal(text), "");
+	const std::string path = tempPath("old.ini");
+	std::ofstream(path) << text;
+	PoseOptions base;
+	base.band_ratio_x = 7;	// not the file's: the file's model is off
+	const PoseOptions o = loadCalibration(path, base);
+	std::filesystem::remove(path);
+	EXPECT_EQ(o.band_ratio_x, 0);
+	EXPECT_EQ(o.band_ratio_y, 0);
+	EXPECT_TRUE(o.band_floor_x_table.empty());
+	// Its C_P is the tables' whatever the detector measured.
+	const Eigen::Vector4d P(-40, 30, 45, 33);
+	EXPECT_EQ(o.primaryCovariance(P, 0, 0.05), o.primaryCovariance(P));
 }
 
 TEST(Calibration, LineNumberIsTheKeysLine)

@@ -519,6 +519,54 @@ TEST(PrimaryCovariance, FollowsTheImageNoise)
 	EXPECT_THROW(o.validate(), std::invalid_argument);
 }
 
+// The scatter model: a detection whose bands the detector measured gets
+// (band_ratio se)^2 + floor(size)^2 per axis, with the tables' correlations
+// and no noise scaling; one without bands, and a prediction, keep the
+// tables.
+TEST(PrimaryCovariance, FollowsTheBandsScatter)
+{
+	PoseOptions o;
+	o.sigma_x_table = sigmaTableFromString("20:0.05 80:0.01");
+	o.sigma_y_table = sigmaTableFromString("40:0.04 160:0.008");
+	o.corr_growth_x12 = -0.2;
+	o.corr_growth_y12 = 0.3;
+	o.reference_noise_grey = 2;
+	o.noise_sigma_x_table = sigmaTableFromString("20:0.03 80:0.006");
+	const Eigen::Vector4d P(-40, 40, 40, 41);  // width 80 px, height 81 px
+	const Eigen::Matrix4d C_tables = o.primaryCovariance(P, 4.0);
+	// Off: the bands' scatter changes nothing.
+	EXPECT_EQ(o.primaryCovariance(P, 4.0, 0.03), C_tables);
+	o.band_ratio_x = 5;
+	o.band_ratio_y = 4;
+	o.band_floor_x_table = sigmaTableFromString("20:0.1 80:0.02");
+	// Not measured (0): the tables, noise scaling included.
+	EXPECT_EQ(o.primaryCovariance(P, 4.0, 0.0), C_tables);
+	for (const double se : {0.005, 0.02, 0.08})
+	{
+		const Eigen::Matrix4d C = o.primaryCovariance(P, 4.0, se);
+		const double vx = 25 * se * se + 0.02 * 0.02, vy = 16 * se * se;
+		EXPECT_NEAR(C(0, 0), vx, 1e-15) << se;
+		EXPECT_NEAR(C(2, 2), vx, 1e-15) << se;
+		EXPECT_NEAR(C(0, 2), -0.2 * vx, 1e-15) << se;
+		EXPECT_NEAR(C(1, 1), vy, 1e-15) << se;	// no floor table: none
+		EXPECT_NEAR(C(1, 3), 0.3 * vy, 1e-15) << se;
+		EXPECT_EQ(C(0, 1), 0);
+		// The image's noise is in the scatter already.
+		EXPECT_EQ(o.primaryCovariance(P, 8.0, se), C) << se;
+	}
+	// measure() of a detection takes the detector's scatter.
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	Detection d;
+	d.corners = {{{280, 200}, {360, 200}, {360, 281}, {280, 281}}};
+	d.quality.edge_bend_se_px = 0.01;
+	const double c1 = measure(d, cam, g, o).C_P(0, 0);
+	d.quality.edge_bend_se_px = 0.04;
+	EXPECT_GT(measure(d, cam, g, o).C_P(0, 0), 4 * c1);
+	o.band_ratio_y = -1;
+	EXPECT_THROW(o.validate(), std::invalid_argument);
+}
+
 // The tabulated sigma, the clipped sides' and the aligned edges' terms.
 TEST(PrimaryCovariance, TablesClippedSidesAndAlignedEdges)
 {

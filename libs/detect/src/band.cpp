@@ -220,6 +220,12 @@ bool centreOnBandOnce(
 		const double move = medianOf(residuals);
 		if (std::abs(move) <= kMaxMovePx) next.sides[side].c -= move;
 	}
+	if (decide && static_cast<int>(excess.size()) >= kMinProfiles)
+	{
+		const MedianWithError m = medianWithError(excess);
+		q.bend_px = next.bend_px = 0.5 * m.median;
+		q.bend_se_px = next.bend_se_px = 0.5 * m.se;
+	}
 	if (decide && !bandsShowBend(excess)) return false;
 	if (!cornersFromSides(next, cam)) return false;
 	q = std::move(next);

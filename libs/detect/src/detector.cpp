@@ -124,6 +124,8 @@ DetectionResult detectWithModels(
 		}
 		qual.corner_sigma_px = std::sqrt(var_end / 4);
 		qual.fill_clipped = refined->fill_clipped;
+		qual.edge_bend_px = refined->bend_px;
+		qual.edge_bend_se_px = refined->bend_se_px;
 		qual.image_noise_grey =
 			landmarkNoiseRms(bgr, refined->corners_raw, codeCellRatio(fill_ratio));
 		qual.code_margin = code->margin;

@@ -502,6 +502,9 @@ struct RefinedQuad
 	/** Per side: the channel its edges were read in. */
 	std::array<EdgeChannel, 4> channel{
 		{EdgeChannel::Green, EdgeChannel::Green, EdgeChannel::Green, EdgeChannel::Green}};
+	/** The bands' bend (DetectionQuality::edge_bend_px) and its standard
+	 * error [px]; 0 when not measured. */
+	double bend_px = 0, bend_se_px = 0;
 };
 
 /** Edge profiles along each side of \a coarse (one per row or column), the

@@ -180,6 +180,12 @@ pose::PoseOptions parametricNoiseModel(const pose::PoseOptions& in)
 {
 	pose::PoseOptions o = in;
 	const double ref = o.size_reference_px;
+	// The scatter model (band_ratio_x) follows the corners' error from
+	// camera to camera; a run holds one camera, whose noise the constant
+	// and size-dependent parts below describe.
+	o.band_ratio_x = o.band_ratio_y = 0;
+	o.band_floor_x_table.clear();
+	o.band_floor_y_table.clear();
 	if (!o.sigma_x_table.empty())
 	{
 		const auto [a, b] = fitTable(o.sigma_x_table, ref);

@@ -46,8 +46,9 @@ CObservationCodedLandmarks::TSighting CObservationCodedLandmarks::TSighting::Fro
 }
 
 // Version 1 adds DetectionQuality::fill_clipped (a bit per side), version 2
-// DetectionQuality::image_noise_grey.
-uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 2; }
+// DetectionQuality::image_noise_grey, version 3 edge_bend_px and
+// edge_bend_se_px.
+uint8_t CObservationCodedLandmarks::serializeGetVersion() const { return 3; }
 
 void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -72,6 +73,7 @@ void CObservationCodedLandmarks::serializeTo(mrpt::serialization::CArchive& out)
 		for (int k = 0; k < 4; ++k) clipped |= s.quality.fill_clipped[k] ? (1u << k) : 0u;
 		out.WriteAs<uint8_t>(clipped);
 		out << s.quality.image_noise_grey;
+		out << s.quality.edge_bend_px << s.quality.edge_bend_se_px;
 	}
 }
 
@@ -82,6 +84,7 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 		case 0:
 		case 1:
 		case 2:
+		case 3:
 		{
 			in >> timestamp >> sensorLabel >> cameraPose >> camera;
 			const auto n = in.ReadAs<uint32_t>();
@@ -129,6 +132,16 @@ void CObservationCodedLandmarks::serializeFrom(mrpt::serialization::CArchive& in
 						THROW_EXCEPTION_FMT(
 							"CObservationCodedLandmarks: corrupt data, image noise %g",
 							s.quality.image_noise_grey);
+				}
+				if (version >= 3)
+				{
+					in >> s.quality.edge_bend_px >> s.quality.edge_bend_se_px;
+					if (!std::isfinite(s.quality.edge_bend_px) ||
+						!(s.quality.edge_bend_se_px >= 0) ||
+						!std::isfinite(s.quality.edge_bend_se_px))
+						THROW_EXCEPTION_FMT(
+							"CObservationCodedLandmarks: corrupt data, edge bend %g +- %g",
+							s.quality.edge_bend_px, s.quality.edge_bend_se_px);
 				}
 				// A detection never has a non-finite measurement; such a value
 				// would only poison a filter later, far from its cause.

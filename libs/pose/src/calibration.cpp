@@ -31,12 +31,20 @@ struct Key
 	Kind kind;
 	double PoseOptions::*number = nullptr;	//!< the field of a number
 	SigmaTable PoseOptions::*table = nullptr;  //!< the field of a table
+	/** A key the format gained later: a file without it keeps loading, the
+	 * key's model off (0, or an empty table). */
+	bool optional = false;
 };
 
 Key number(const char* name, Kind kind, double PoseOptions::*field) { return {name, kind, field}; }
 Key table(const char* name, SigmaTable PoseOptions::*field)
 {
 	return {name, Kind::Table, nullptr, field};
+}
+Key optional(Key k)
+{
+	k.optional = true;
+	return k;
 }
 
 // PoseOptions' noise model (measurement.h documents each field).
@@ -65,6 +73,10 @@ const Key kKeys[] = {
 	number("corner_tilt_ratio", Kind::Positive, &PoseOptions::corner_tilt_ratio),
 	table("corner_tilt_ratio_table", &PoseOptions::corner_tilt_ratio_table),
 	number("corner_tilt_noise_ratio", Kind::NonNegative, &PoseOptions::corner_tilt_noise_ratio),
+	optional(number("band_ratio_x", Kind::NonNegative, &PoseOptions::band_ratio_x)),
+	optional(number("band_ratio_y", Kind::NonNegative, &PoseOptions::band_ratio_y)),
+	optional(table("band_floor_x_table", &PoseOptions::band_floor_x_table)),
+	optional(table("band_floor_y_table", &PoseOptions::band_floor_y_table)),
 };
 
 std::string trimmed(const std::string& s)
@@ -210,13 +222,20 @@ PoseOptions loadCalibration(const std::string& path, const PoseOptions& base)
 	}
 	if (!has_pose) throw std::runtime_error(path + ": no [pose] section (not a calibration file)");
 	for (const Key& k : kKeys)
-		if (!line_of.count(k.name))
+		if (!line_of.count(k.name) && !k.optional)
 			throw std::invalid_argument(
 				path + ": [pose] misses key '" + k.name +
 				"' (a calibration sets every key of the noise model; docs/calibration.md)");
 	PoseOptions o = base;
 	for (const Key& k : kKeys)
-		if (k.table)
+		if (!line_of.count(k.name))
+		{
+			if (k.table)
+				(o.*k.table).clear();
+			else
+				o.*k.number = 0;
+		}
+		else if (k.table)
 			o.*k.table = sigmaTableFromString(values[k.name]);
 		else
 			o.*k.number = *parseFiniteNumber(values[k.name]);
@@ -298,8 +317,11 @@ PoseOptions scaledNoiseModel(const PoseOptions& in, double factor)
 	o.growth_x_px *= factor;
 	o.growth_y_px *= factor;
 	o.clipped_side_sigma_px *= factor;
+	o.band_ratio_x *= factor;
+	o.band_ratio_y *= factor;
 	for (auto* t :
-		 {&o.sigma_x_table, &o.sigma_y_table, &o.noise_sigma_x_table, &o.noise_sigma_y_table})
+		 {&o.sigma_x_table, &o.sigma_y_table, &o.noise_sigma_x_table, &o.noise_sigma_y_table,
+		  &o.band_floor_x_table, &o.band_floor_y_table})
 		for (auto& entry : *t) entry.second *= factor;
 	return o;
 }

@@ -145,9 +145,13 @@ void PoseOptions::validate() const
 			"pose options: corner_tilt_noise_ratio must be finite and >= 0");
 	if (!(reference_noise_grey >= 0) || !std::isfinite(reference_noise_grey))
 		throw std::invalid_argument("pose options: reference_noise_grey must be finite and >= 0");
+	if (!(band_ratio_x >= 0) || !(band_ratio_y >= 0) || !std::isfinite(band_ratio_x) ||
+		!std::isfinite(band_ratio_y))
+		throw std::invalid_argument(
+			"pose options: band_ratio_x, band_ratio_y must be finite and >= 0");
 	for (const SigmaTable* t :
 		 {&sigma_x_table, &sigma_y_table, &noise_sigma_x_table, &noise_sigma_y_table,
-		  &corner_tilt_ratio_table})
+		  &corner_tilt_ratio_table, &band_floor_x_table, &band_floor_y_table})
 		for (size_t k = 0; k < t->size(); ++k)
 			if (!((*t)[k].first > 0) || !((*t)[k].second > 0) || !std::isfinite((*t)[k].second) ||
 				(k > 0 && !((*t)[k].first > (*t)[k - 1].first)))
@@ -167,6 +171,7 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 		 "corr_growth_y12", "clipped_side_sigma_px", "clipped_side_correlation",
 		 "aligned_edge_ratio", "corner_midpoint_ratio", "corner_tilt_ratio",
 		 "corner_tilt_noise_ratio", "min_sigma_px", "reference_noise_grey"});
+	requireIniNumbers(c, s, {"band_ratio_x", "band_ratio_y"});
 	requireIniNumbers(c, s, {"lm_max_iterations"}, true);
 	requireIniBooleans(
 		c, s, {"second_order_pose_covariance", "refine_on_primary", "fold_ambiguity"});
@@ -183,6 +188,10 @@ void PoseOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, con
 	noise_sigma_y_table = readSigmaTable(c, s, "noise_sigma_y_table", noise_sigma_y_table);
 	corner_tilt_ratio_table =
 		readSigmaTable(c, s, "corner_tilt_ratio_table", corner_tilt_ratio_table);
+	MRPT_LOAD_CONFIG_VAR(band_ratio_x, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(band_ratio_y, double, c, s);
+	band_floor_x_table = readSigmaTable(c, s, "band_floor_x_table", band_floor_x_table);
+	band_floor_y_table = readSigmaTable(c, s, "band_floor_y_table", band_floor_y_table);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_x, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_exponent_y, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(size_reference_px, double, c, s);
@@ -236,6 +245,18 @@ void PoseOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::
 	c.write(
 		s, "noise_sigma_y_table", toString(noise_sigma_y_table), -1, -1,
 		"size:sigma pairs [px], the noise-driven part of sigma(y1, y2) at reference_noise_grey");
+	c.write(
+		s, "band_ratio_x", band_ratio_x, -1, -1,
+		"sigma(x1, x2) over the scatter of the landmark's green bands; 0: off");
+	c.write(
+		s, "band_ratio_y", band_ratio_y, -1, -1,
+		"sigma(y1, y2) over the scatter of the landmark's green bands; 0: off");
+	c.write(
+		s, "band_floor_x_table", toString(band_floor_x_table), -1, -1,
+		"size:sigma pairs [px] added to the band term of x1, x2 against x2 - x1");
+	c.write(
+		s, "band_floor_y_table", toString(band_floor_y_table), -1, -1,
+		"size:sigma pairs [px] added to the band term of y1, y2 against y1 + y2");
 	c.write(
 		s, "size_exponent_x", size_exponent_x, -1, -1,
 		"sigma_x = sqrt(sigma_px^2 + (growth_x_px (ref / (x2 - x1))^exp)^2)");
@@ -306,7 +327,7 @@ double PoseOptions::cornerTiltRatio(double height_px) const
 }
 
 Eigen::Matrix4d PoseOptions::primaryCovariance(
-	const Eigen::Vector4d& P, double image_noise_grey) const
+	const Eigen::Vector4d& P, double image_noise_grey, double band_se_px) const
 {
 	// Apparent sizes, floored at 1 px so that a degenerate P gives a large
 	// but finite covariance.
@@ -330,10 +351,30 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(
 		C(1, 1) = C(3, 3) = v;
 		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
 	}
+	// The scatter model (band_ratio_x), per axis.
+	const auto band = [&](double ratio, const SigmaTable& floor, double size)
+	{
+		const double f = floor.empty() ? 0.0 : interpolateSigma(floor, size);
+		return ratio * ratio * band_se_px * band_se_px + f * f;
+	};
+	const bool band_x = band_ratio_x > 0 && band_se_px > 0,
+			   band_y = band_ratio_y > 0 && band_se_px > 0;
+	if (band_x)
+	{
+		const double v = band(band_ratio_x, band_floor_x_table, w);
+		C(0, 0) = C(2, 2) = v;
+		C(0, 2) = C(2, 0) = corr_growth_x12 * v;
+	}
+	if (band_y)
+	{
+		const double v = band(band_ratio_y, band_floor_y_table, h);
+		C(1, 1) = C(3, 3) = v;
+		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
+	}
 	// Each axis's block scaled as a whole keeps its correlation and stays
 	// positive definite.
-	const double kx = noiseScale(true, w, C(0, 0), image_noise_grey);
-	const double ky = noiseScale(false, h, C(1, 1), image_noise_grey);
+	const double kx = band_x ? 1.0 : noiseScale(true, w, C(0, 0), image_noise_grey);
+	const double ky = band_y ? 1.0 : noiseScale(false, h, C(1, 1), image_noise_grey);
 	for (const int i : {0, 2})
 		for (const int j : {0, 2})
 		{
@@ -362,12 +403,12 @@ Eigen::Matrix4d PoseOptions::clippedSidesCovariance(const std::array<bool, 4>& c
 }
 
 Eigen::Matrix4d PoseOptions::alignedEdgesCovariance(
-	const Eigen::Vector4d& P, double top_rows, double bottom_rows) const
+	const Eigen::Vector4d& P, double top_rows, double bottom_rows, double band_se_px) const
 {
 	Eigen::Matrix4d C = Eigen::Matrix4d::Zero();
 	if (aligned_edge_ratio <= 0) return C;
 	// sigma_y(h)^2 of the y model (the diagonal holds no correlation).
-	const double vy = primaryCovariance(P)(1, 1);
+	const double vy = primaryCovariance(P, 0, band_se_px)(1, 1);
 	const auto weight = [](double rows) { return std::max(0.0, 1 - std::abs(rows)); };
 	// Each aligned edge's shift d moves y1 and y2 by d / 2.
 	const double h = 0.25 * aligned_edge_ratio * aligned_edge_ratio * vy *
@@ -381,14 +422,14 @@ namespace
 Measurement measureWith(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options,
-	const std::array<bool, 4>& clipped, double image_noise_grey)
+	const std::array<bool, 4>& clipped, double image_noise_grey, double band_se_px)
 {
 	options.validate();
 	Measurement m;
 	m.method = options.method;
 	double lambda = 0;
 	m.P = primaryMeasurement(corners, camera, &lambda);
-	const Eigen::Matrix4d C_primary = options.primaryCovariance(m.P, image_noise_grey);
+	const Eigen::Matrix4d C_primary = options.primaryCovariance(m.P, image_noise_grey, band_se_px);
 	m.C_P = C_primary + options.clippedSidesCovariance(clipped);
 	if (options.aligned_edge_ratio > 0)
 	{
@@ -396,7 +437,7 @@ Measurement measureWith(
 		std::array<Eigen::Vector2d, 4> ideal;
 		for (int k = 0; k < 4; ++k) ideal[k] = camera.undistortPixel(corners[k]);
 		m.C_P += options.alignedEdgesCovariance(
-			m.P, ideal[1].y() - ideal[0].y(), ideal[2].y() - ideal[3].y());
+			m.P, ideal[1].y() - ideal[0].y(), ideal[2].y() - ideal[3].y(), band_se_px);
 	}
 	const auto poseCovariance = [&](const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L,
 									const Eigen::Matrix3d& first_order) {
@@ -485,7 +526,7 @@ Measurement measureWith(
 	Eigen::Vector2d tilt_extra = Eigen::Vector2d::Zero();
 	if (options.corner_tilt_noise_ratio > 0 && image_noise_grey > 0)
 	{
-		const Eigen::Matrix4d grown = C_primary - options.primaryCovariance(m.P, 0);
+		const Eigen::Matrix4d grown = C_primary - options.primaryCovariance(m.P, 0, band_se_px);
 		const double k2 = options.corner_tilt_noise_ratio * options.corner_tilt_noise_ratio -
 						  tilt_ratio * tilt_ratio;
 		tilt_extra = k2 * Eigen::Vector2d(grown(0, 0), grown(2, 2));
@@ -533,7 +574,7 @@ Measurement measure(
 	const std::array<Eigen::Vector2d, 4>& corners, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const PoseOptions& options)
 {
-	return measureWith(corners, camera, geometry, options, {{false, false, false, false}}, 0);
+	return measureWith(corners, camera, geometry, options, {{false, false, false, false}}, 0, 0);
 }
 
 Measurement measure(
@@ -550,12 +591,13 @@ Measurement measure(
 		// The tables would override the detector's sigma.
 		o.sigma_x_table.clear();
 		o.sigma_y_table.clear();
+		o.band_ratio_x = o.band_ratio_y = 0;
 		// The detector's sigma already follows its image's noise.
 		o.reference_noise_grey = 0;
 	}
 	return measureWith(
 		detection.corners, camera, geometry, o, detection.quality.fill_clipped,
-		detection.quality.image_noise_grey);
+		detection.quality.image_noise_grey, detection.quality.edge_bend_se_px);
 }
 
 }  // namespace codemark::pose

@@ -43,6 +43,13 @@ struct DetectionQuality
 	 * than 8 such blocks). pose::PoseOptions::reference_noise_grey scales
 	 * the noise-driven part of C_P with it. */
 	double image_noise_grey = 0;
+	/** How far the camera moves the edges towards their dark sides [px]:
+	 * half the median excess of the green bands' measured width (between
+	 * the frame and a black code cell) over the printed one. A transfer
+	 * curve, sharpening or a clipped fill make it positive, printers' dot
+	 * gain negative; about 0 in linear light. 0 when not measured. */
+	double edge_bend_px = 0;
+	double edge_bend_se_px = 0;	 //!< the standard error of edge_bend_px [px]
 };
 
 /** One detected landmark. */

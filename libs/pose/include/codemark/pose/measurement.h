@@ -190,9 +190,10 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	double aligned_edge_ratio = 0;
 	/** The part of C_P that aligned top and bottom edges add (see
 	 * aligned_edge_ratio), from the ends' row differences [px] of the top
-	 * and bottom edges. */
+	 * and bottom edges; \a band_se_px as in primaryCovariance(). */
 	Eigen::Matrix4d alignedEdgesCovariance(
-		const Eigen::Vector4d& P, double top_rows_px, double bottom_rows_px) const;
+		const Eigen::Vector4d& P, double top_rows_px, double bottom_rows_px,
+		double band_se_px = 0) const;
 	/** C_P of a measured or predicted P under these options (without the
 	 * detector's own sigma), the sum of a constant and a size-dependent part,
 	 * each with its correlation of the two edges:
@@ -204,7 +205,31 @@ struct PoseOptions : public mrpt::config::CLoadableOptions
 	 * sigma_y^2). With reference_noise_grey > 0 and \a image_noise_grey > 0
 	 * each axis's block is then scaled to the image's noise
 	 * (noiseScale()). */
-	Eigen::Matrix4d primaryCovariance(const Eigen::Vector4d& P, double image_noise_grey = 0) const;
+	Eigen::Matrix4d primaryCovariance(
+		const Eigen::Vector4d& P, double image_noise_grey = 0, double band_se_px = 0) const;
+	/** The scatter model of a detection: where band_ratio_x (band_ratio_y)
+	 * is > 0 and the detector measured the scatter of the landmark's green
+	 * bands (\a band_se_px = DetectionQuality::edge_bend_se_px > 0),
+	 * primaryCovariance() gives x1 and x2 (y1 and y2) the variance
+	 * (band_ratio_x band_se_px)^2 + band_floor_x(w)^2 in place of the
+	 * models above, with corr_growth_x12 (corr_growth_y12) between the two
+	 * edges, and no noise scaling (the scatter already holds the image's
+	 * noise). The bands' edges see what the frame's inner edges see (the
+	 * image's noise, demosaicing, sharpening, compression, a chromatic
+	 * fringe), so their scatter over the landmark follows the corners'
+	 * error from camera to camera, where the constant and tabulated models
+	 * hold for one camera only (docs/calibration.md). A prediction (no
+	 * image) and a detection without bands keep the models above.
+	 * Default 0: off. ini keys `band_ratio_x`, `band_ratio_y`. */
+	double band_ratio_x = 0;
+	double band_ratio_y = 0;  //!< see band_ratio_x
+	/** The part of the scatter model's sigma that the bands do not see
+	 * (a thin frame's edges pulling on each other, the bend that remains),
+	 * tabulated against the apparent width w = x2 - x1 [px] as the sigma
+	 * tables; empty: 0. ini key `band_floor_x_table`. */
+	SigmaTable band_floor_x_table;
+	/** The same for y1, y2 against y1 + y2. ini key `band_floor_y_table`. */
+	SigmaTable band_floor_y_table;
 	/** The noise at which the sigmas above were measured [grey levels], as
 	 * the detector measures it (the mean DetectionQuality::image_noise_grey
 	 * on the calibration renders, so that its estimator's bias cancels).
