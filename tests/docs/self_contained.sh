@@ -5,12 +5,13 @@
 set -euo pipefail
 cd "$1"
 pattern='\.\./shared|landmark-spec\.md|paper-notes|mrpt-notes|ARCHITECTURE\.md|STYLE\.md'
-if [[ -d .git ]] && command -v git >/dev/null; then
+# A checkout's .git is a directory, a worktree's a file.
+if [[ -e .git ]] && command -v git >/dev/null; then
 	files=$(git ls-files)
 else
 	files=$(find . -type f -not -path './build*' -not -path './.git/*')
 fi
-hits=$(grep -n -I -E "$pattern" $files 2>/dev/null | grep -v '^tests/docs/self_contained.sh:' || true)
+hits=$(grep -n -I -E "$pattern" $files 2>/dev/null | grep -v -E '^(\./)?tests/docs/self_contained.sh:' || true)
 if [[ -n "$hits" ]]; then
 	echo "files that refer to documents outside the repository:"
 	echo "$hits"
