@@ -157,6 +157,7 @@ struct FrameResult
 	double line_rms_px = NAN;  // the four line fits' RMS residual, averaged
 	double corner_sigma_px = NAN;  // the detector's own corner sigma
 	double noise_grey = NAN;  // the image noise the detector measured
+	double bend_px = NAN, bend_se_px = NAN;	 // the bands' bend and its standard error
 };
 
 double wrapPi(double a) { return std::atan2(std::sin(a), std::cos(a)); }
@@ -200,6 +201,8 @@ FrameResult evaluate(
 			0.25 * (q.line_rms_px[0] + q.line_rms_px[1] + q.line_rms_px[2] + q.line_rms_px[3]);
 		out.corner_sigma_px = q.corner_sigma_px;
 		out.noise_grey = q.image_noise_grey;
+		out.bend_px = q.edge_bend_px;
+		out.bend_se_px = q.edge_bend_se_px;
 		double w = 0, h = 0;
 		sideLengths(c, &w, &h);
 		out.width_err_px = w - w_true;
@@ -394,7 +397,8 @@ void writeCsv(const std::string& path, const std::vector<Run>& runs)
 	if (!os) throw std::runtime_error(path + ": cannot write");
 	os << "source,preset,group,index,distance_m,view_deg,light,print,side_px,"
 		  "eligible,detected,wrong_ids,corner_err_px,width_err_px,height_err_px,range_err_rel,"
-		  "phi2_err_deg,pos_err_m,nees,line_rms_px,corner_sigma_px,noise_grey\n";
+		  "phi2_err_deg,pos_err_m,nees,line_rms_px,corner_sigma_px,noise_grey,bend_px,"
+		  "bend_se_px\n";
 	for (const auto& run : runs)
 		for (const auto& r : run.frames)
 		{
@@ -405,7 +409,7 @@ void writeCsv(const std::string& path, const std::vector<Run>& runs)
 			   << "," << r.corner_err_px << "," << r.width_err_px << "," << r.height_err_px << ","
 			   << r.range_err_rel << "," << r.phi2_err_rad / kDeg << "," << r.pos_err_m << ","
 			   << r.nees << "," << r.line_rms_px << "," << r.corner_sigma_px << "," << r.noise_grey
-			   << "\n";
+			   << "," << r.bend_px << "," << r.bend_se_px << "\n";
 		}
 }
 
@@ -453,7 +457,9 @@ int main(int argc, char** argv)
 			"", "csv",
 			"per-frame CSV: the frame, its errors and NEES, and what the detector measured of "
 			"the landmark (line_rms_px: the four line fits' RMS residual, averaged; "
-			"corner_sigma_px: the corner sigma the line fits give; noise_grey: the image noise)",
+			"corner_sigma_px: the corner sigma the line fits give; noise_grey: the image noise; "
+			"bend_px, bend_se_px: the green bands' bend and its standard error, 0 when not "
+			"measured)",
 			false, "", "FILE.csv", cmd);
 		TCLAP::ValueArg<std::string> revisionArg(
 			"", "revision", "revision named in the report", false, "", "TEXT", cmd);
