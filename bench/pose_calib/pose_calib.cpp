@@ -63,6 +63,7 @@ struct Sample
 	double image_noise = 0;	 // DetectionQuality::image_noise_grey (0: not measured)
 	double bend = 0, bend_se = 0;  // DetectionQuality::edge_bend_px, edge_bend_se_px
 	int group = 0;	// --vary-scene: print (i % 3) + 3 * light
+	int preset = 0;	 // its --preset's index in the list
 	Eigen::Vector4d P_true = Eigen::Vector4d::Zero();
 	/** Clipped sides on x1, x2 (left, right: 0 or 1) and on y1, y2 (top and bottom: 0-2). */
 	int clippedOn(int component) const
@@ -370,7 +371,8 @@ int main(int argc, char** argv)
 		{
 			int m = 0;
 			// Poses of its own per preset (the first keeps --seed's).
-			const auto v = collect(ro_presets[k], m, seed_arg.getValue() + 7919 * k);
+			auto v = collect(ro_presets[k], m, seed_arg.getValue() + 7919 * k);
+			for (auto& sm : v) sm.preset = static_cast<int>(k);
 			samples.insert(samples.end(), v.begin(), v.end());
 			missed += m;
 		}
@@ -380,7 +382,7 @@ int main(int argc, char** argv)
 			f << "distance_m,angle_deg,side_px,width_px,e_tl_u,e_tl_v,e_tr_u,e_tr_v,e_br_u,e_br_v,"
 				 "e_bl_u,e_bl_v,e_x1,e_y1,e_x2,e_y2,clipped_top,clipped_right,clipped_bottom,"
 				 "clipped_left,rms_top,rms_right,rms_bottom,rms_left,image_noise,group,support_top,"
-				 "support_right,support_bottom,support_left,code_margin,bend,bend_se\n";
+				 "support_right,support_bottom,support_left,code_margin,bend,bend_se,preset\n";
 			for (const auto& s : samples)
 			{
 				f << s.d << "," << s.angle_deg << "," << s.side_px << "," << s.width_px;
@@ -390,7 +392,8 @@ int main(int argc, char** argv)
 				for (int k = 0; k < 4; ++k) f << "," << s.line_rms[k];
 				f << "," << s.image_noise << "," << s.group;
 				for (int k = 0; k < 4; ++k) f << "," << s.line_support[k];
-				f << "," << s.code_margin << "," << s.bend << "," << s.bend_se << "\n";
+				f << "," << s.code_margin << "," << s.bend << "," << s.bend_se << ","
+				  << presets[s.preset] << "\n";
 			}
 		}
 		std::printf("%zu detections, %d missed\n", samples.size(), missed);

@@ -91,6 +91,38 @@ bool bandsShowBend(std::vector<double> excess)
 	return std::abs(m.median) >= kMinZ * m.se;
 }
 
+/** The factor of a median's variance over neighbouring profiles whose
+ * errors are correlated: (1 + r) / (1 - r), r the lag-1 correlation of
+ * \a v between profiles of one run (\a run) one pixel apart (\a pos),
+ * taken in [0, 0.9]. A camera's denoising, its demosaicing and its
+ * compression's blocks spread an error along an edge over several
+ * profiles, which then average out less than independent ones would (the
+ * standard error of a mean of AR(1) samples); 1 with fewer than 8 pairs. */
+double correlationInflation(
+	const std::vector<double>& v, const std::vector<int>& run, const std::vector<int>& pos)
+{
+	constexpr int kMinPairs = 8;
+	constexpr double kMaxCorrelation = 0.9;
+	double mean = 0;
+	for (const double x : v) mean += x;
+	mean /= std::max<size_t>(1, v.size());
+	double cross = 0, square = 0;
+	int pairs = 0;
+	for (size_t k = 0; k < v.size(); ++k)
+	{
+		square += (v[k] - mean) * (v[k] - mean);
+		if (k > 0 && run[k] == run[k - 1] && std::abs(pos[k] - pos[k - 1]) == 1)
+		{
+			cross += (v[k] - mean) * (v[k - 1] - mean);
+			++pairs;
+		}
+	}
+	if (pairs < kMinPairs || !(square > 0)) return 1;
+	// Lag-1 pairs against all the samples' variance.
+	const double r = std::clamp(cross / pairs / (square / v.size()), 0.0, kMaxCorrelation);
+	return (1 + r) / (1 - r);
+}
+
 /** Across coordinate at along coordinate \a s of the segment \a p0 - \a p1
  * (raw px); nullopt outside it. */
 std::optional<double> acrossOn(
@@ -116,6 +148,9 @@ bool centreOnBandOnce(
 	const int W = bgr.cols, H = bgr.rows;
 	RefinedQuad next = q;
 	std::vector<double> residuals, excess;
+	// Per excess: the profile's side, cell and position along the side, to
+	// pair neighbouring profiles (bendStandardError()).
+	std::vector<int> run_of, pos_of;
 	std::vector<int> v, vr;
 	const auto g_at = [&](const Eigen::Vector2d& f)
 	{
@@ -206,6 +241,8 @@ bool centreOnBandOnce(
 				const double measured = e_cell - *e_in;
 				if (measured < 0.5 * width || measured > 1.5 * width) continue;
 				excess.push_back(measured - width);
+				run_of.push_back(3 * side + c);
+				pos_of.push_back(s);
 				// The inner edge: half the band's predicted width outside
 				// its measured midline.
 				const double e = 0.5 * (*e_in + e_cell) - 0.5 * (t_cell - t_in);
@@ -224,7 +261,8 @@ bool centreOnBandOnce(
 	{
 		const MedianWithError m = medianWithError(excess);
 		q.bend_px = next.bend_px = 0.5 * m.median;
-		q.bend_se_px = next.bend_se_px = 0.5 * m.se;
+		q.bend_se_px = next.bend_se_px =
+			0.5 * m.se * std::sqrt(correlationInflation(excess, run_of, pos_of));
 	}
 	if (decide && !bandsShowBend(excess)) return false;
 	if (!cornersFromSides(next, cam)) return false;

@@ -49,7 +49,11 @@ struct DetectionQuality
 	 * curve, sharpening or a clipped fill make it positive, printers' dot
 	 * gain negative; about 0 in linear light. 0 when not measured. */
 	double edge_bend_px = 0;
-	double edge_bend_se_px = 0;	 //!< the standard error of edge_bend_px [px]
+	/** The standard error of edge_bend_px [px], from the bands' scatter
+	 * over the landmark and its correlation between neighbouring profiles
+	 * (what a camera's denoising, demosaicing and compression spread along
+	 * an edge averages out less). */
+	double edge_bend_se_px = 0;
 };
 
 /** One detected landmark. */
