@@ -149,7 +149,7 @@ bool centreOnBandOnce(
 	RefinedQuad next = q;
 	std::vector<double> residuals, excess;
 	// Per excess: the profile's side, cell and position along the side, to
-	// pair neighbouring profiles (bendStandardError()).
+	// pair neighbouring profiles (correlationInflation()).
 	std::vector<int> run_of, pos_of;
 	std::vector<int> v, vr;
 	const auto g_at = [&](const Eigen::Vector2d& f)

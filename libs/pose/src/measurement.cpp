@@ -339,18 +339,17 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(
 	Eigen::Matrix4d C = Eigen::Vector4d(vx, vy, vx, vy).asDiagonal();
 	C(0, 2) = C(2, 0) = corr_x12 * fx2 + corr_growth_x12 * gx * gx;
 	C(1, 3) = C(3, 1) = corr_y12 * fy2 + corr_growth_y12 * gy * gy;
+	// One axis's block (i = 0: x1, x2; 1: y1, y2) as variance v with
+	// correlation r between the two edges.
+	const auto setAxis = [&C](int i, double v, double r)
+	{
+		C(i, i) = C(i + 2, i + 2) = v;
+		C(i, i + 2) = C(i + 2, i) = r * v;
+	};
 	if (!sigma_x_table.empty())
-	{
-		const double v = std::pow(interpolateSigma(sigma_x_table, w), 2);
-		C(0, 0) = C(2, 2) = v;
-		C(0, 2) = C(2, 0) = corr_growth_x12 * v;
-	}
+		setAxis(0, std::pow(interpolateSigma(sigma_x_table, w), 2), corr_growth_x12);
 	if (!sigma_y_table.empty())
-	{
-		const double v = std::pow(interpolateSigma(sigma_y_table, h), 2);
-		C(1, 1) = C(3, 3) = v;
-		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
-	}
+		setAxis(1, std::pow(interpolateSigma(sigma_y_table, h), 2), corr_growth_y12);
 	// The scatter model (band_ratio_x), per axis.
 	const auto band = [&](double ratio, const SigmaTable& floor, double size)
 	{
@@ -359,18 +358,8 @@ Eigen::Matrix4d PoseOptions::primaryCovariance(
 	};
 	const bool band_x = band_ratio_x > 0 && band_se_px > 0,
 			   band_y = band_ratio_y > 0 && band_se_px > 0;
-	if (band_x)
-	{
-		const double v = band(band_ratio_x, band_floor_x_table, w);
-		C(0, 0) = C(2, 2) = v;
-		C(0, 2) = C(2, 0) = corr_growth_x12 * v;
-	}
-	if (band_y)
-	{
-		const double v = band(band_ratio_y, band_floor_y_table, h);
-		C(1, 1) = C(3, 3) = v;
-		C(1, 3) = C(3, 1) = corr_growth_y12 * v;
-	}
+	if (band_x) setAxis(0, band(band_ratio_x, band_floor_x_table, w), corr_growth_x12);
+	if (band_y) setAxis(1, band(band_ratio_y, band_floor_y_table, h), corr_growth_y12);
 	// Each axis's block scaled as a whole keeps its correlation and stays
 	// positive definite.
 	const double kx = band_x ? 1.0 : noiseScale(true, w, C(0, 0), image_noise_grey);
