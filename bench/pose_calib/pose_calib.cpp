@@ -224,6 +224,12 @@ int main(int argc, char** argv)
 			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> csv_arg(
 			"", "csv", "Per-detection CSV to write.", false, "", "FILE", cmd);
+		TCLAP::SwitchArg scatter_arg(
+			"", "scatter-model",
+			"Also fit the scatter model (PoseOptions::band_ratio_x, band_floor_x_table: C_P "
+			"from the standard error of each detection's bands) and write it with --out; "
+			"without it the calibration holds the tables alone.",
+			cmd, false);
 		TCLAP::ValueArg<double> noise_split_arg(
 			"", "noise-split",
 			"Render the same poses again at this pixel noise [grey levels] and print the part "
@@ -232,6 +238,9 @@ int main(int argc, char** argv)
 			false, 0, "S", cmd);
 		cmd.setExceptionHandling(false);
 		cmd.parse(argc, argv);
+		if (scatter_arg.getValue() && averaged_arg.getValue())
+			throw std::invalid_argument(
+				"--scatter-model adds to the tabulated fit: drop --averaged");
 		if (renderer_arg.getValue() != "own" && renderer_arg.getValue() != "povray")
 			throw std::invalid_argument(
 				"--renderer must be own or povray, got '" + renderer_arg.getValue() + "'");
@@ -731,7 +740,13 @@ int main(int argc, char** argv)
 				std::vector<Sample> banded;
 				for (const auto& sm : samples)
 					if (sm.bend_se > 0) banded.push_back(sm);
-				if (banded.size() >= 100 && !averaged_arg.getValue())
+				if (scatter_arg.getValue() && banded.size() < 100)
+					throw std::runtime_error(
+						"--scatter-model: the detector measured the bands on " +
+						std::to_string(banded.size()) +
+						" detections, under the 100 the fit needs (more --renders, or renders "
+						"whose frames span at least 3 px)");
+				if (scatter_arg.getValue())
 				{
 					const auto bandFit = [&](bool x, double& ratio)
 					{
