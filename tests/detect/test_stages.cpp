@@ -326,6 +326,39 @@ TEST(Components, CentreEvidence)
 
 // ------------------------------------------------------------------ edgels
 
+TEST(Edgels, ReducedGreenIsTheBlocksRoundedMean)
+{
+	// Random levels (every rounding case) in a ROI off the image's origin;
+	// each factor, the unrolled ones and the general loop: the block's mean
+	// rounded half up, and cv::resize(INTER_AREA) to a grey level (it
+	// rounds some ties down).
+	cv::Mat bgr(97, 131, CV_8UC3);
+	cv::RNG rng(5);
+	rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+	for (int k = 2; k <= 6; ++k)
+	{
+		const cv::Rect roi(3, 5, 120 - 120 % k, 90 - 90 % k);
+		const cv::Mat got = reducedGreen(bgr, roi, k);
+		ASSERT_EQ(got.size(), cv::Size(roi.width / k, roi.height / k)) << "k = " << k;
+		int worst = 0;
+		for (int y = 0; y < got.rows; ++y)
+			for (int x = 0; x < got.cols; ++x)
+			{
+				int sum = 0;
+				for (int r = 0; r < k; ++r)
+					for (int c = 0; c < k; ++c)
+						sum += bgr.at<cv::Vec3b>(roi.y + y * k + r, roi.x + x * k + c)[1];
+				const int mean = static_cast<int>(std::floor(double(sum) / (k * k) + 0.5));
+				worst = std::max(worst, std::abs(got.at<uint8_t>(y, x) - mean));
+			}
+		EXPECT_EQ(worst, 0) << "k = " << k;
+		cv::Mat g, area;
+		cv::extractChannel(bgr(roi), g, 1);
+		cv::resize(g, area, got.size(), 0, 0, cv::INTER_AREA);
+		EXPECT_LE(cv::norm(got, area, cv::NORM_INF), 1) << "k = " << k;
+	}
+}
+
 TEST(Edgels, PolarityOfTheInnerEdges)
 {
 	const cv::Mat img = craftedLandmark(0);

@@ -126,6 +126,11 @@ struct EdgelMap
 /** Gradient threshold for a candidate whose fill has mean G \a fill_g. */
 double gradientThreshold(double fill_g, const EdgelParams& p);
 
+/** G of \a roi (within \a bgr, its size a multiple of \a k >= 2) reduced
+ * by \a k: each k x k block's mean, rounded half up, as
+ * cv::resize(INTER_AREA) gives it. */
+cv::Mat reducedGreen(const cv::Mat& bgr, const cv::Rect& roi, int k);
+
 /** Gradients of G (3x3 Sobel) in \a roi, non-maximum suppressed edgels
  * with polarity, grouped into domains. At full resolution unless the ROI is
  * larger than max_roi_px, then reduced by an integer factor (domains are
