@@ -21,9 +21,7 @@ namespace
 {
 /** reducedGreen() by a factor known at compile time (the common ones), so
  * that the block's loops unroll and the rounding division becomes a
- * multiplication. Written by hand: cv::extractChannel and then cv::resize
- * read and wrote the ROI twice, a third of the edgel stage on near
- * landmarks. */
+ * multiplication. */
 template <int K>
 void reduceGreenBy(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& g)
 {
@@ -42,7 +40,6 @@ void reduceGreenBy(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& g)
 		}
 	}
 }
-
 }  // namespace
 
 cv::Mat reducedGreen(const cv::Mat& bgr, const cv::Rect& roi, int k)

@@ -127,8 +127,10 @@ struct EdgelMap
 double gradientThreshold(double fill_g, const EdgelParams& p);
 
 /** G of \a roi (within \a bgr, its size a multiple of \a k >= 2) reduced
- * by \a k: each k x k block's mean, rounded half up, as
- * cv::resize(INTER_AREA) gives it. */
+ * by \a k: each k x k block's mean rounded half up (cv::resize(INTER_AREA)
+ * gives it to a grey level: it rounds some ties down). Written by hand:
+ * cv::extractChannel and then cv::resize read and wrote the ROI twice, a
+ * third of the edgel stage on near landmarks. */
 cv::Mat reducedGreen(const cv::Mat& bgr, const cv::Rect& roi, int k);
 
 /** Gradients of G (3x3 Sobel) in \a roi, non-maximum suppressed edgels
