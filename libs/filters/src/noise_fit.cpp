@@ -395,9 +395,9 @@ NoiseFitResult fitSightingNoise(
 		std::ostringstream w;
 		w << std::setprecision(2) << "the first sightings of each landmark visit read NIS/DoF "
 		  << r.after.visit_ratio << " against " << r.after.other_ratio
-		  << " for the others: the sightings' errors persist from frame to frame, which the "
-			 "innovations of consecutive sightings do not show; the fitted noise then errs small "
-			 "(docs/calibration.md)";
+		  << " for the others: the sightings' errors persist from frame to frame; the constant "
+			 "noise found absorbs the jumps between landmarks, so the filter's state covariance "
+			 "may be wider than its errors (docs/calibration.md)";
 		r.warnings.push_back(w.str());
 	}
 	if (r.sightings < 30)
