@@ -735,93 +735,91 @@ int main(int argc, char** argv)
 			// floor(size)^2 with the table's clipped and aligned terms; K by
 			// maximum likelihood on a grid, the floor per size bin given K
 			// (bins of at least 150 detections: a floor is a small
-			// difference of two variances, noisy on fewer).
+			// difference of two variances, noisy on fewer). Only with
+			// --scatter-model.
+			if (scatter_arg.getValue())
 			{
 				std::vector<Sample> banded;
 				for (const auto& sm : samples)
 					if (sm.bend_se > 0) banded.push_back(sm);
-				if (scatter_arg.getValue() && banded.size() < 100)
+				if (banded.size() < 100)
 					throw std::runtime_error(
 						"--scatter-model: the detector measured the bands on " +
 						std::to_string(banded.size()) +
 						" detections, under the 100 the fit needs (more --renders, or renders "
 						"whose frames span at least 3 px)");
-				if (scatter_arg.getValue())
+				const auto bandFit = [&](bool x, double& ratio)
 				{
-					const auto bandFit = [&](bool x, double& ratio)
+					double best_total = 1e300;
+					pose::SigmaTable best_table;
+					const auto bins = sizeBins(
+						banded, [&](const Sample& sm) { return sizeOf(sm, x); }, 150);
+					for (int i = 1; i <= 120; ++i)
 					{
-						double best_total = 1e300;
-						pose::SigmaTable best_table;
-						const auto bins = sizeBins(
-							banded, [&](const Sample& sm) { return sizeOf(sm, x); }, 150);
-						for (int i = 1; i <= 120; ++i)
+						const double k = 0.1 * i;
+						double total = 0;
+						pose::SigmaTable t;
+						for (const SizeBin& bin : bins)
 						{
-							const double k = 0.1 * i;
-							double total = 0;
-							pose::SigmaTable t;
-							for (const SizeBin& bin : bins)
+							double best = 1e300, best_floor = 0;
+							for (int g = 0; g <= 200; ++g)
 							{
-								double best = 1e300, best_floor = 0;
-								for (int g = 0; g <= 200; ++g)
-								{
-									// 0, then 0.001 to 1 px.
-									const double fl =
-										g == 0 ? 0.0 : 1e-3 * std::pow(1e3, g / 200.0);
-									double nll = 0;
-									for (const Sample* sm : bin.samples)
-										for (const int c : {x ? 0 : 1, x ? 2 : 3})
-										{
-											const double v =
-												(k * k * sm->bend_se * sm->bend_se + fl * fl) *
-													(1 + aligned(*sm, c)) +
-												share(*sm, c);
-											nll += sm->e_P[c] * sm->e_P[c] / v + std::log(v);
-										}
-									if (nll < best)
+								// 0, then 0.001 to 1 px.
+								const double fl = g == 0 ? 0.0 : 1e-3 * std::pow(1e3, g / 200.0);
+								double nll = 0;
+								for (const Sample* sm : bin.samples)
+									for (const int c : {x ? 0 : 1, x ? 2 : 3})
 									{
-										best = nll;
-										best_floor = fl;
+										const double v =
+											(k * k * sm->bend_se * sm->bend_se + fl * fl) *
+												(1 + aligned(*sm, c)) +
+											share(*sm, c);
+										nll += sm->e_P[c] * sm->e_P[c] / v + std::log(v);
 									}
+								if (nll < best)
+								{
+									best = nll;
+									best_floor = fl;
 								}
-								total += best;
-								// A table holds sigmas > 0: 0.1 mpx stands for none.
-								const double f = std::max(1e-4, best_floor);
-								const double p10 = std::pow(10, std::floor(std::log10(f)) - 2);
-								if (t.empty() || bin.size_px > t.back().first)
-									t.emplace_back(bin.size_px, std::round(f / p10) * p10);
 							}
-							if (total < best_total)
-							{
-								best_total = total;
-								best_table = t;
-								ratio = k;
-							}
+							total += best;
+							// A table holds sigmas > 0: 0.1 mpx stands for none.
+							const double f = std::max(1e-4, best_floor);
+							const double p10 = std::pow(10, std::floor(std::log10(f)) - 2);
+							if (t.empty() || bin.size_px > t.back().first)
+								t.emplace_back(bin.size_px, std::round(f / p10) * p10);
 						}
-						return best_table;
-					};
-					double kx = 0, ky = 0;
-					const pose::SigmaTable fx_t = bandFit(true, kx), fy_t = bandFit(false, ky);
-					const auto bandVar = [&](const Sample& sm, int c)
-					{
-						const bool x = c % 2 == 0;
-						const double k = x ? kx : ky,
-									 f = pose::interpolateSigma(x ? fx_t : fy_t, sizeOf(sm, x));
-						return (k * k * sm.bend_se * sm.bend_se + f * f) * (1 + aligned(sm, c)) +
-							   share(sm, c);
-					};
-					const Normalised zb = normalised(banded, bandVar);
-					std::printf(
-						"scatter model (%zu of %zu detections with bands measured):\n"
-						"  band_ratio_x = %.1f\n  band_ratio_y = %.1f\n"
-						"  band_floor_x_table = %s\n  band_floor_y_table = %s\n"
-						"  normalised variance x %.3f y %.3f midpoint %.3f tilt %.3f\n",
-						banded.size(), samples.size(), kx, ky, pose::toString(fx_t).c_str(),
-						pose::toString(fy_t).c_str(), zb.x, zb.y, zb.midpoint, zb.tilt);
-					fitted.band_ratio_x = kx;
-					fitted.band_ratio_y = ky;
-					fitted.band_floor_x_table = fx_t;
-					fitted.band_floor_y_table = fy_t;
-				}
+						if (total < best_total)
+						{
+							best_total = total;
+							best_table = t;
+							ratio = k;
+						}
+					}
+					return best_table;
+				};
+				double kx = 0, ky = 0;
+				const pose::SigmaTable fx_t = bandFit(true, kx), fy_t = bandFit(false, ky);
+				const auto bandVar = [&](const Sample& sm, int c)
+				{
+					const bool x = c % 2 == 0;
+					const double k = x ? kx : ky,
+								 f = pose::interpolateSigma(x ? fx_t : fy_t, sizeOf(sm, x));
+					return (k * k * sm.bend_se * sm.bend_se + f * f) * (1 + aligned(sm, c)) +
+						   share(sm, c);
+				};
+				const Normalised zb = normalised(banded, bandVar);
+				std::printf(
+					"scatter model (%zu of %zu detections with bands measured):\n"
+					"  band_ratio_x = %.1f\n  band_ratio_y = %.1f\n"
+					"  band_floor_x_table = %s\n  band_floor_y_table = %s\n"
+					"  normalised variance x %.3f y %.3f midpoint %.3f tilt %.3f\n",
+					banded.size(), samples.size(), kx, ky, pose::toString(fx_t).c_str(),
+					pose::toString(fy_t).c_str(), zb.x, zb.y, zb.midpoint, zb.tilt);
+				fitted.band_ratio_x = kx;
+				fitted.band_ratio_y = ky;
+				fitted.band_floor_x_table = fx_t;
+				fitted.band_floor_y_table = fy_t;
 			}
 			// The one ratio where no bin gives one (exact renders: no tilt error).
 			const auto tiltRatio2 = [&](const Sample& sm)
