@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 namespace codemark::detect
 {
@@ -356,47 +357,52 @@ std::optional<double> thinFrameOffset(
 		t[5] = std::clamp(t[5], lo_bound[1], hi_bound[1]);
 		t[6] = std::clamp(t[6], lo_bound[2], hi_bound[2]);
 	};
-	const auto residuals = [&](const Vec7& t, Mat7* JtJ, Vec7* Jtr)
+	// The model's cost at \a t; where it is below \a accept, also its
+	// Gauss-Newton Hessian and gradient (a rejected step needs only the
+	// cost: the bins' pixel steps are kept in between).
+	std::vector<std::array<PixelStep, 3>> steps(data.size());
+	const auto residuals = [&](const Vec7& t, double accept, Mat7& JtJ, Vec7& Jtr)
 	{
+		const double W = t[0], M = t[1], K = t[2], G = t[3];
 		double cost = 0;
-		if (JtJ) JtJ->setZero();
-		if (Jtr) Jtr->setZero();
-		for (const Bin& d : data)
+		for (size_t b = 0; b < data.size(); ++b)
 		{
 			// The frame's and the margin's edges move with the inner one.
-			const double x = d.x - t[6];
+			const double x = data[b].x - t[6];
 			const double at[3] = {x + frame_px + t[5], x + frame_px, x};
-			std::array<PixelStep, 3> st;
-			pixelStepsAt(at, 3, t[4], st.data());
-			const PixelStep &s1 = st[0], &s2 = st[1], &s3 = st[2];
-			const double W = t[0], M = t[1], K = t[2], G = t[3];
-			const double model = W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value;
-			const double r = model - d.v;
-			cost += d.w * r * r;
-			if (JtJ)
-			{
-				Vec7 J;
-				J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
-					fixed_sigma > 0
-						? 0.0
-						: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
-					(M - W) * s1.d_x, -((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
-				// The upper triangle only (mirrored below): half the
-				// products of the outer product, in this fit's inner loop.
-				const Vec7 wJ = d.w * J;
-				for (int c = 0; c < 7; ++c)
-					for (int rw = 0; rw <= c; ++rw) (*JtJ)(rw, c) += wJ[rw] * J[c];
-				*Jtr += r * wJ;
-			}
+			pixelStepsAt(at, 3, t[4], steps[b].data());
+			const PixelStep &s1 = steps[b][0], &s2 = steps[b][1], &s3 = steps[b][2];
+			const double r =
+				W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value - data[b].v;
+			cost += data[b].w * r * r;
 		}
-		if (JtJ)
+		if (!(cost < accept)) return cost;
+		JtJ.setZero();
+		Jtr.setZero();
+		for (size_t b = 0; b < data.size(); ++b)
+		{
+			const PixelStep &s1 = steps[b][0], &s2 = steps[b][1], &s3 = steps[b][2];
+			const double r =
+				W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value - data[b].v;
+			Vec7 J;
+			J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
+				fixed_sigma > 0 ? 0.0
+								: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
+				(M - W) * s1.d_x, -((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
+			// The upper triangle only (mirrored below): half the products
+			// of the outer product, in this fit's inner loop.
+			const Vec7 wJ = data[b].w * J;
 			for (int c = 0; c < 7; ++c)
-				for (int rw = c + 1; rw < 7; ++rw) (*JtJ)(rw, c) = (*JtJ)(c, rw);
+				for (int rw = 0; rw <= c; ++rw) JtJ(rw, c) += wJ[rw] * J[c];
+			Jtr += r * wJ;
+		}
+		for (int c = 0; c < 7; ++c)
+			for (int rw = c + 1; rw < 7; ++rw) JtJ(rw, c) = JtJ(c, rw);
 		return cost;
 	};
 	Mat7 H;
 	Vec7 g;
-	double cost = residuals(q, &H, &g), mu = 1e-3;
+	double cost = residuals(q, std::numeric_limits<double>::infinity(), H, g), mu = 1e-3;
 	bool converged = false;
 	// Box bounds of the blur, the margin and the offset: a parameter at its
 	// bound whose gradient points out of the box stays there for the step
@@ -421,7 +427,7 @@ std::optional<double> thinFrameOffset(
 		clampParams(cand);
 		Mat7 Hc;
 		Vec7 gc;
-		const double cc = residuals(cand, &Hc, &gc);
+		const double cc = residuals(cand, cost, Hc, gc);
 		if (cc < cost)
 		{
 			converged = std::abs(cand[6] - q[6]) < 1e-4 && cost - cc < 1e-8 * cost;
