@@ -114,12 +114,15 @@ double stepPeak(const std::array<double, 3>& d, int peak, double e0, double var0
 		const Eigen::Vector3d rc = model(cand, &Jc);
 		if (rc.squaredNorm() < cost)
 		{
+			// The step taken: a blur held at its bound (a sharp edge in
+			// linear light) proposes steps it cannot take.
+			const Eigen::Vector3d taken = cand - q;
 			q = cand;
 			r = rc;
 			J = Jc;
 			cost = rc.squaredNorm();
 			mu = std::max(1e-9, mu * 0.3);
-			if (std::abs(step[0]) < 1e-4 && std::abs(step[1]) < 1e-3) break;
+			if (std::abs(taken[0]) < 1e-4 && std::abs(taken[1]) < 1e-3) break;
 		}
 		else
 			mu *= 10;
