@@ -836,7 +836,8 @@ bool imputeClippedSide(
 				g = g_c;
 				H = H_c;
 				mu = std::max(1e-7, mu * 0.3);
-				if (std::abs(taken[kE0]) < kSettledPx && std::abs(taken[kSigma]) < kSettledPx) break;
+				if (std::abs(taken[kE0]) < kSettledPx && std::abs(taken[kSigma]) < kSettledPx)
+					break;
 			}
 			else
 				mu *= 10;

@@ -392,8 +392,9 @@ std::optional<double> thinFrameOffset(
 				W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value - data[b].v;
 			Vec7 J;
 			J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
-				fixed_sigma > 0 ? 0.0
-								: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
+				fixed_sigma > 0
+					? 0.0
+					: (M - W) * s1.d_sigma + (K - M) * s2.d_sigma + (G - K) * s3.d_sigma,
 				(M - W) * s1.d_x, -((M - W) * s1.d_x + (K - M) * s2.d_x + (G - K) * s3.d_x);
 			// The upper triangle only (mirrored below): half the products
 			// of the outer product, in this fit's inner loop.
