@@ -437,13 +437,7 @@ std::optional<double> thinFrameOffset(
 		const double cc = residuals(cand, cost, Hc, gc);
 		if (cc < cost)
 		{
-			// Settled: an undamped step (a damped one is short whatever
-			// the distance left) that moves the offset by under 3e-4 px.
-			// The fit converges linearly where the model misses the
-			// profile's shape (an encoded camera's sharpening): the offset
-			// then lies within a few thousandths of a pixel of the optimum,
-			// where a test on the cost would run several more steps.
-			converged = std::abs(cand[6] - q[6]) < 3e-4 && mu <= 1e-3;
+			converged = std::abs(cand[6] - q[6]) < 1e-4 && cost - cc < 1e-8 * cost;
 			q = cand;
 			cost = cc;
 			H = Hc;
