@@ -365,8 +365,9 @@ std::optional<double> thinFrameOffset(
 	};
 	// The model's cost at \a t; where it is below \a accept, also its
 	// Gauss-Newton Hessian and gradient (a rejected step needs only the
-	// cost: the bins' pixel steps are kept in between).
+	// cost: the bins' pixel steps and residuals are kept in between).
 	std::vector<std::array<PixelStep, 3>> steps(data.size());
+	std::vector<double> res(data.size());
 	const auto residuals = [&](const Vec7& t, double accept, Mat7& JtJ, Vec7& Jtr)
 	{
 		const double W = t[0], M = t[1], K = t[2], G = t[3];
@@ -378,7 +379,7 @@ std::optional<double> thinFrameOffset(
 			const double at[3] = {x + frame_px + t[5], x + frame_px, x};
 			pixelStepsAt(at, 3, t[4], steps[b].data());
 			const PixelStep &s1 = steps[b][0], &s2 = steps[b][1], &s3 = steps[b][2];
-			const double r =
+			const double r = res[b] =
 				W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value - data[b].v;
 			cost += data[b].w * r * r;
 		}
@@ -388,8 +389,6 @@ std::optional<double> thinFrameOffset(
 		for (size_t b = 0; b < data.size(); ++b)
 		{
 			const PixelStep &s1 = steps[b][0], &s2 = steps[b][1], &s3 = steps[b][2];
-			const double r =
-				W + (M - W) * s1.value + (K - M) * s2.value + (G - K) * s3.value - data[b].v;
 			Vec7 J;
 			J << 1 - s1.value, s1.value - s2.value, s2.value - s3.value, s3.value,
 				fixed_sigma > 0
@@ -401,7 +400,7 @@ std::optional<double> thinFrameOffset(
 			const Vec7 wJ = data[b].w * J;
 			for (int c = 0; c < 7; ++c)
 				for (int rw = 0; rw <= c; ++rw) JtJ(rw, c) += wJ[rw] * J[c];
-			Jtr += r * wJ;
+			Jtr += res[b] * wJ;
 		}
 		for (int c = 0; c < 7; ++c)
 			for (int rw = c + 1; rw < 7; ++rw) JtJ(rw, c) = JtJ(c, rw);
