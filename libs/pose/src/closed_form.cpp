@@ -84,17 +84,14 @@ Eigen::Matrix3d poseCovarianceSecondOrder(const Eigen::Vector3d& L, const Eigen:
 	return C;
 }
 
-Eigen::Vector4d primaryFromLandmark(
-	const Eigen::Vector3d& L, double lambda, double h, Eigen::Matrix<double, 4, 3>* J_L)
+bool primaryFromLandmark(
+	double l2, double c1, double s1, double c2, double s2, double lambda, double h,
+	Eigen::Vector4d& P, Eigen::Matrix<double, 4, 3>* J_L)
 {
-	const double l2 = L[0], c1 = std::cos(L[1]), s1 = std::sin(L[1]), c2 = std::cos(L[2]),
-				 s2 = std::sin(L[2]);
 	// Forward and left coordinates of the left (1) and right (2) edge centres.
 	const double f[2] = {l2 * c1 + h * s2, l2 * c1 - h * s2};
 	const double g[2] = {l2 * s1 + h * c2, l2 * s1 - h * c2};
-	if (!(f[0] > 0) || !(f[1] > 0) || !(lambda > 0))
-		throw std::invalid_argument("primaryFromLandmark: an edge is not in front of the camera");
-	Eigen::Vector4d P;
+	if (!(f[0] > 0) || !(f[1] > 0) || !(lambda > 0)) return false;
 	for (int i = 0; i < 2; ++i)
 	{
 		P[2 * i] = -lambda * g[i] / f[i];
@@ -115,6 +112,17 @@ Eigen::Vector4d primaryFromLandmark(
 			}
 		}
 	}
+	return true;
+}
+
+Eigen::Vector4d primaryFromLandmark(
+	const Eigen::Vector3d& L, double lambda, double h, Eigen::Matrix<double, 4, 3>* J_L)
+{
+	Eigen::Vector4d P;
+	if (!primaryFromLandmark(
+			L[0], std::cos(L[1]), std::sin(L[1]), std::cos(L[2]), std::sin(L[2]), lambda, h, P,
+			J_L))
+		throw std::invalid_argument("primaryFromLandmark: an edge is not in front of the camera");
 	return P;
 }
 

@@ -143,6 +143,9 @@ class ParticleFilterLocalizer : public Localizer
 	bool m_converged = false;
 	int m_unexplained = 0;
 	int m_injections = 0;
+	/** The volume [m^2 rad] of the initial uniform cloud while no sighting
+	 * has updated it, else 0 (injectAroundFixes()). */
+	double m_uniform_volume = 0;
 };
 
 }  // namespace codemark::filters

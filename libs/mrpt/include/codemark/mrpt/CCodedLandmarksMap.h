@@ -2,9 +2,12 @@
 /** \file CCodedLandmarksMap.h
  * A metric map of coded landmarks (id, pose, scale) for MRPT's particle
  * filters: the observation likelihood of codemark::CObservationCodedLandmarks
- * (Gaussian in L = [l2 phi1 phi2] with each sighting's C_L, mixed with a
- * uniform for outliers) and of mrpt::obs::CObservationBearingRange with
- * landmark IDs (Gaussian in range, yaw, pitch). It lives in the plugin so
+ * and of mrpt::obs::CObservationBearingRange with landmark IDs (Gaussian in
+ * range, yaw, pitch), each mixed with a uniform for outliers. A coded
+ * sighting of the closed form (a level camera) is scored where it was
+ * measured: its primary measurement P = [x1 y1 x2 y2] against the P that
+ * the particle's pose predicts, with its C_P (scoreP()); other sightings
+ * (the general 6-DoF path) in L = [l2 phi1 phi2] with their C_L. It lives in the plugin so
  * that stock tools (pf-localization with LD_PRELOAD) can build it from an ini:
  *
  *     [MetricMap]
@@ -41,15 +44,20 @@ class CCodedLandmarksMap : public mrpt::maps::CMetricMap
 		 * (1 - p) N(r; 0, C) + p U: the probability that a sighting is an
 		 * outlier (wrong ID, bad detection), in [0, 1). */
 		double outlier_probability = 0.05;
-		/** Multiplies every standard deviation of C_L (and of the range-
-		 * bearing covariances): > 1 makes the filter trust sightings less. */
+		/** Multiplies every standard deviation of C_P and C_L (and of the
+		 * range-bearing covariances): > 1 makes the filter trust sightings
+		 * less. */
 		double sigma_scale = 1.0;
-		/** Standard deviation added in quadrature to the range [m]. */
+		/** Standard deviation added in quadrature to the range [m] (for a
+		 * sighting scored in P, mapped into P through dP/dL at the
+		 * particle's predicted L). */
 		double min_std_range_m = 0.01;
-		/** Standard deviation added in quadrature to each angle [deg]. */
+		/** Standard deviation added in quadrature to each angle [deg] (as
+		 * min_std_range_m). */
 		double min_std_angle_deg = 0.5;
-		/** Upper range of the outliers' uniform density [m]; the angles'
-		 * span is 2 pi each. */
+		/** Upper range of the outliers' uniform density in L [m]; the
+		 * angles' span is 2 pi each. In P the uniform spans the image: x1,
+		 * x2 its width, y1, y2 half its height. */
 		double max_range_m = 20.0;
 
 		void loadFromConfigFile(
@@ -157,6 +165,17 @@ class CCodedLandmarksMap : public mrpt::maps::CMetricMap
 	double scoreL(
 		const Eigen::Vector3d& L, const Eigen::Matrix3d& C_L, double xl, double yl, double ux,
 		double uy) const;
+	/** The mixture log-likelihood of a measured \a P (covariance \a C_P)
+	 * of a landmark with inner half-height \a h_m seen with focal length
+	 * \a lambda_px, for a camera at (\a xl, \a yl [m], heading (\a ux,
+	 * \a uy)) in the landmark's frame: N(P; P(L), sigma_scale^2 C_P + J D
+	 * J^T), L the pose's predicted L, J = dP/dL there and D the floors on
+	 * L's diagonal, mixed with the uniform of density exp(\a log_uniform).
+	 * A camera behind the landmark's plane, or an edge behind the camera,
+	 * scores the uniform alone. */
+	double scoreP(
+		const Eigen::Vector4d& P, const Eigen::Matrix4d& C_P, double h_m, double lambda_px,
+		double log_uniform, double xl, double yl, double ux, double uy) const;
 	int indexOf(int id) const;
 };
 

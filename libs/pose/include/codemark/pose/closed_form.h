@@ -45,6 +45,14 @@ Eigen::Vector4d primaryFromLandmark(
 	const Eigen::Vector3d& L, double lambda_px, double h_m,
 	Eigen::Matrix<double, 4, 3>* J_L = nullptr);
 
+/** primaryFromLandmark() from l2 and the cosines and sines of phi1 and
+ * phi2, without trigonometry and without throwing: false (and \a P, \a J_L
+ * untouched) when an edge is not in front of the camera. For hot loops (the
+ * particle filter's likelihood, once per particle and sighting). */
+bool primaryFromLandmark(
+	double l2, double cos_phi1, double sin_phi1, double cos_phi2, double sin_phi2, double lambda_px,
+	double h_m, Eigen::Vector4d& P, Eigen::Matrix<double, 4, 3>* J_L = nullptr);
+
 /** L from P by weighted least squares: the closed form's four equations
  * have three unknowns, and its formulas combine them unweighted (phi2 from
  * y2 - y1 alone, wasting the square's foreshortened width x2 - x1, which
