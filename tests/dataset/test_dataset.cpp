@@ -124,6 +124,25 @@ TEST(Dataset, ActionsObservationsRawlog)
 	EXPECT_EQ(LandmarkMap::load(dir + "/map.txt").landmarks.size(), 12u);
 }
 
+TEST(Dataset, OutputFolderIsCreatedWithItsParents)
+{
+	const auto base = tempDir("nested");
+	const auto dir = base + "/a/b";
+	EXPECT_EQ(writeDataset(smallOptions(), dir, false, {}, 2).frames, 2);
+	EXPECT_TRUE(mrpt::system::fileExists(dir + "/dataset.rawlog"));
+	// Under a regular file no folder can be made: an error naming it.
+	std::ofstream(base + "/file") << "x";
+	try
+	{
+		writeDataset(smallOptions(), base + "/file/c", false, {}, 2);
+		ADD_FAILURE() << "no error";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(base + "/file/c"), std::string::npos) << e.what();
+	}
+}
+
 TEST(Dataset, ObservationsOnlyHasOdometryAtItsOwnTimes)
 {
 	const auto dir = tempDir("obs");

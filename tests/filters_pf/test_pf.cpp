@@ -464,6 +464,42 @@ TEST(ParticleFilter, FirstFixIsAsWideAsTheLikelihood)
 	}
 }
 
+// The regularisation moves each particle by N(0, (r h)^2 C): the same
+// cloud before it, the covariance after it grows by 1 + (r h)^2. A flat
+// likelihood keeps the weights equal, so that the sample covariances are
+// those of all the particles.
+TEST(ParticleFilter, RegularisationWidensTheCloudByItsKernel)
+{
+	constexpr int kParticles = 2000;
+	codemark::filters::PoseEstimate init;
+	init.initialized = true;
+	init.mean = kPose;
+	init.cov = Eigen::Vector3d(0.04, 0.04, 0.01).asDiagonal();
+	std::mt19937 rng(3);
+	mrpt::obs::CSensoryFrame sf;
+	sf.insert(pft::observe(kPose, pft::room(), &rng));
+	auto cloud = [&](double roughening)
+	{
+		auto cfg = shippedConfig(4);
+		cfg.write("PF_options", "adaptiveSampleSize", 0);
+		cfg.write("ParticleFilter", "particles_count", kParticles);
+		cfg.write("ParticleFilter", "roughening", roughening);
+		cfg.write("MetricMap_codedLandmarksMap_00_likelihoodOpts", "sigma_scale", 1e4);
+		codemark::filters::ParticleFilterLocalizer f(cfg, pft::room(), init);
+		f.step(nullptr, sf);
+		EXPECT_EQ(f.particles().m_particles.size(), size_t(kParticles));
+		return f.estimate().cov;
+	};
+	const Eigen::Matrix3d plain = cloud(0);
+	for (const double r : {2.0, 4.0})
+	{
+		const Eigen::Matrix3d rough = cloud(r);
+		const double h2 = r * r * std::pow(4.0 / (kParticles * 5.0), 2.0 / 7.0);
+		for (int i = 0; i < 3; ++i)
+			EXPECT_NEAR(rough(i, i) / plain(i, i), 1 + h2, 0.2 * h2) << "r " << r << " axis " << i;
+	}
+}
+
 TEST(ParticleFilter, RecoversFromAKidnapping)
 {
 	auto cfg = shippedConfig(7);

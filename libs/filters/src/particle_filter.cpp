@@ -28,16 +28,20 @@ constexpr double kDeg = M_PI / 180.0;
 const char* const kSection = "ParticleFilter";
 const char* const kLikelihoodSection = "MetricMap_codedLandmarksMap_00_likelihoodOpts";
 
-/** One draw of N(mean, C) with MRPT's generator (reproducible with
- * random_seed); C must be positive semi-definite. */
+/** One draw of N(0, I) in 3-D with MRPT's generator (reproducible with
+ * random_seed). */
+Eigen::Vector3d drawStandardNormal()
+{
+	auto& rng = mrpt::random::getRandomGenerator();
+	const double a = rng.drawGaussian1D_normalized(), b = rng.drawGaussian1D_normalized();
+	return {a, b, rng.drawGaussian1D_normalized()};
+}
+
+/** One draw of N(mean, C); C must be positive semi-definite. */
 Eigen::Vector3d drawGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& C)
 {
 	Eigen::LLT<Eigen::Matrix3d> llt(C);
-	auto& rng = mrpt::random::getRandomGenerator();
-	const Eigen::Vector3d z(
-		rng.drawGaussian1D_normalized(), rng.drawGaussian1D_normalized(),
-		rng.drawGaussian1D_normalized());
-	return mean + llt.matrixL() * z;
+	return mean + llt.matrixL() * drawStandardNormal();
 }
 
 /** A robot pose hypothesis from one sighting. */
@@ -64,6 +68,7 @@ void ParticleFilterOptions::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(inject_min_std_yaw_deg, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(converged_std_xy_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(converged_std_yaw_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(roughening, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(random_seed, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(no_odometry_std_xy_m, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(no_odometry_std_yaw_deg, double, c, s);
@@ -73,6 +78,7 @@ void ParticleFilterOptions::loadFromConfigFile(
 	};
 	require(particles_count > 0, "particles_count", "must be > 0");
 	require(init_margin_m >= 0, "init_margin_m", "must be >= 0");
+	require(roughening >= 0, "roughening", "must be >= 0");
 	require(initial_std_xy_m >= 0 && initial_std_yaw_deg >= 0, "initial_std_*", "must be >= 0");
 	require(inject_fraction > 0 && inject_fraction <= 1, "inject_fraction", "must be in (0, 1]");
 	require(
@@ -104,6 +110,7 @@ void ParticleFilterOptions::saveToConfigFile(
 	c.write(s, "inject_min_std_yaw_deg", inject_min_std_yaw_deg, -1, -1);
 	c.write(s, "converged_std_xy_m", converged_std_xy_m, -1, -1);
 	c.write(s, "converged_std_yaw_deg", converged_std_yaw_deg, -1, -1);
+	c.write(s, "roughening", roughening, -1, -1);
 	c.write(s, "random_seed", random_seed, -1, -1);
 	c.write(s, "no_odometry_std_xy_m", no_odometry_std_xy_m, -1, -1);
 	c.write(s, "no_odometry_std_yaw_deg", no_odometry_std_yaw_deg, -1, -1);
@@ -297,6 +304,7 @@ StepStats ParticleFilterLocalizer::step(
 		}
 	}
 
+	if (!sf.empty() && m_opts.roughening > 0) regularise();
 	if (!sf.empty()) m_uniform_volume = 0;	// a sighting has shaped the cloud
 	// Convergence (sticky).
 	const PoseEstimate e = estimate();
@@ -481,6 +489,27 @@ bool ParticleFilterLocalizer::injectAroundFixes(const mrpt::obs::CSensoryFrame& 
 	m_pdf.normalizeWeights();
 	++m_injections;
 	return true;
+}
+
+// MRPT's CParticleFilter offers no regularisation: written here.
+void ParticleFilterLocalizer::regularise()
+{
+	auto& parts = m_pdf.m_particles;
+	if (parts.size() < 2) return;
+	const auto [cov, mean] = m_pdf.getCovarianceAndMean();
+	const Eigen::Matrix3d C = 0.5 * (cov.asEigen() + cov.asEigen().transpose());
+	constexpr double d = 3;
+	const double h =
+		m_opts.roughening * std::pow(4.0 / (double(parts.size()) * (d + 2)), 1.0 / (d + 4));
+	const Eigen::LLT<Eigen::Matrix3d> llt(h * h * C);
+	if (llt.info() != Eigen::Success || !C.allFinite())
+		return;	 // a collapsed cloud: nothing to spread
+	const Eigen::Matrix3d L = llt.matrixL();
+	for (auto& p : parts)
+	{
+		const Eigen::Vector3d v = Eigen::Vector3d(p.d.x, p.d.y, p.d.phi) + L * drawStandardNormal();
+		p.d = mrpt::math::TPose2D(v[0], v[1], mrpt::math::wrapToPi(v[2]));
+	}
 }
 
 // MRPT's particle filter checks nothing: an overflowing motion (e.g. a huge

@@ -9,7 +9,8 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/random/RandomGenerators.h>
 #include <mrpt/serialization/CArchive.h>
-#include <mrpt/system/filesystem.h>
+
+#include <filesystem>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -382,11 +383,12 @@ DatasetSummary writeDataset(
 		o.camera_file.empty() ? CameraModel::paperDefault() : CameraModel::load(o.camera_file);
 	const CPose3D cam_on_robot = o.cameraPoseOnRobot();
 
-	if (!mrpt::system::directoryExists(out_dir) && !mrpt::system::createDirectory(out_dir))
-		throw std::runtime_error(out_dir + ": cannot create output directory");
+	// With its missing parents (mrpt::system::createDirectory() makes one level).
 	const std::string img_dir = out_dir + "/dataset_Images";
-	if (!mrpt::system::directoryExists(img_dir) && !mrpt::system::createDirectory(img_dir))
-		throw std::runtime_error(img_dir + ": cannot create image directory");
+	std::error_code ec;
+	std::filesystem::create_directories(img_dir, ec);
+	if (ec || !std::filesystem::is_directory(img_dir))
+		throw std::runtime_error(img_dir + ": cannot create the output directory: " + ec.message());
 
 	reseedMrptRandom(o.seed);
 	const Trajectory trajectory(o);

@@ -58,6 +58,17 @@ struct ParticleFilterOptions : public mrpt::config::CLoadableOptions
 	double converged_std_xy_m = 0.15;
 	double converged_std_yaw_deg = 5.0;
 
+	/** Regularisation (the post-regularised particle filter of Musso,
+	 * Oudjane and Le Gland, 2001): after each update with sightings every
+	 * particle moves by a draw from N(0, (roughening h)^2 C), C the cloud's
+	 * weighted covariance and h = (4 / (N (d + 2)))^(1 / (d + 4)) the
+	 * Gaussian kernel's optimal bandwidth for N particles in d = 3
+	 * dimensions. Resampling copies particles, and a fine odometry barely
+	 * separates the copies: without it the cloud collapses onto a few poses
+	 * while a landmark's first sightings still agree in their error, and
+	 * reports a fraction of the spread it has. >= 0; 0 disables. */
+	double roughening = 0.3;
+
 	/** Seeds MRPT's random generator at construction when >= 0 (tests and
 	 * benchmarks); < 0 leaves it as it is. */
 	int random_seed = -1;
@@ -134,6 +145,8 @@ class ParticleFilterLocalizer : public Localizer
 	/** Throws std::runtime_error when a particle's pose or log-weight, or the
 	 * estimate \a e (mean, covariance), is not finite; step() calls it. */
 	void checkFinite(const PoseEstimate& e) const;
+	/** Moves every particle by the regularisation's kernel (roughening). */
+	void regularise();
 
 	ParticleFilterOptions m_opts;
 	std::shared_ptr<CCodedLandmarksMap> m_map;
