@@ -98,6 +98,7 @@ bool logGauss(
 	out = -0.5 * d2 - 0.5 * (K * std::log(kTwoPi) + std::log(det));
 	return std::isfinite(out);
 }
+
 /** Whether a sighting is scored in P (CCodedLandmarksMap::scoreP()): the
  * closed form's sightings, whose P follows from L by the level camera's
  * model; the general path's L comes from the corners by a 6-DoF pose. */
