@@ -659,4 +659,16 @@ TEST(ParticleFilter, BadConfigurationThrows)
 	auto cfg3 = shippedConfig(1);
 	cfg3.write("MetricMap_codedLandmarksMap_00_likelihoodOpts", "outlier_probability", 1.5);
 	EXPECT_THROW(codemark::filters::makeLocalizer("pf", cfg3, pft::room()), std::invalid_argument);
+	// A negative regularisation is refused with its key.
+	auto cfg4 = shippedConfig(1);
+	cfg4.write("ParticleFilter", "roughening", -0.1);
+	try
+	{
+		codemark::filters::makeLocalizer("pf", cfg4, pft::room());
+		ADD_FAILURE() << "no error";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("roughening"), std::string::npos) << e.what();
+	}
 }

@@ -388,7 +388,9 @@ DatasetSummary writeDataset(
 	std::error_code ec;
 	std::filesystem::create_directories(img_dir, ec);
 	if (ec || !std::filesystem::is_directory(img_dir))
-		throw std::runtime_error(img_dir + ": cannot create the output directory: " + ec.message());
+		throw std::runtime_error(
+			img_dir + ": cannot create the output directory: " +
+			(ec ? ec.message() : std::string("not a folder")));
 
 	reseedMrptRandom(o.seed);
 	const Trajectory trajectory(o);
