@@ -2,6 +2,7 @@
 // over the datasets of a benchmark ini and a set of methods, one job per
 // dataset x method on a pool of threads, and writes results.csv, report.md
 // and plots. The logic is in bench.h (config.cpp, job.cpp, report.cpp).
+#include <codemark/landmark/text.h>
 #include <tclap/CmdLine.h>
 
 #include <condition_variable>
@@ -72,10 +73,7 @@ int main(int argc, char** argv)
 				throw std::runtime_error(
 					cfg.config_dir + "/" + m + ".ini: cannot open (method " + m + ")");
 		const std::string dir = out.getValue();
-		std::error_code ec;
-		fs::create_directories(dir, ec);
-		if (!fs::is_directory(dir))
-			throw std::runtime_error(dir + ": cannot create the output directory");
+		codemark::createFolder(dir, "the output folder");
 
 		struct Job
 		{

@@ -1,6 +1,10 @@
 #include <codemark/landmark/geometry.h>
 #include <codemark/landmark/text.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 using namespace codemark;
 
@@ -38,4 +42,34 @@ TEST(Text, ScaledByKeepsCustomSizes)
 	EXPECT_DOUBLE_EQ(h.outer_size_m, 0.40);
 	EXPECT_THROW(g.scaledBy(0.0), std::invalid_argument);
 	EXPECT_THROW(g.scaledBy(std::nan("")), std::invalid_argument);
+}
+
+TEST(Text, CreateFolderMakesItsParentsAndNamesWhatFails)
+{
+	namespace fs = std::filesystem;
+	const fs::path base =
+		fs::temp_directory_path() / ("codemark-test-folder-" + std::to_string(::getpid()));
+	fs::remove_all(base);
+	const fs::path nested = base / "a" / "b";
+	createFolder(nested.string(), "the test folder");
+	EXPECT_TRUE(fs::is_directory(nested));
+	EXPECT_NO_THROW(createFolder(nested.string(), "the test folder"));	// already there
+	std::ofstream(base / "file") << "x";
+	// The path itself a file, and a parent a file: each named, with a reason.
+	for (const fs::path& bad : {base / "file", base / "file" / "c"})
+	{
+		const std::string head = bad.string() + ": cannot create the test folder: ";
+		try
+		{
+			createFolder(bad.string(), "the test folder");
+			ADD_FAILURE() << bad << ": no error";
+		}
+		catch (const std::runtime_error& e)
+		{
+			const std::string m = e.what();
+			EXPECT_EQ(m.rfind(head, 0), 0u) << m;
+			EXPECT_GT(m.size(), head.size()) << m;
+		}
+	}
+	fs::remove_all(base);
 }

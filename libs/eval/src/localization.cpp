@@ -501,9 +501,7 @@ std::string summaryJson(const LocalizeSummary& s)
 
 void writeOutputs(const LocalizeSummary& s, const LandmarkMap& map, const std::string& dir)
 {
-	std::error_code ec;
-	fs::create_directories(dir, ec);
-	if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": cannot create output directory");
+	createFolder(dir, "the output folder");
 	writeTextFiles(s, dir);
 	writePlot(s, map, dir + "/trajectory.png");
 	writeScene(s, map, dir + "/trajectory.3Dscene");

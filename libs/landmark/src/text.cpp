@@ -252,4 +252,14 @@ void requireIniBooleans(
 	}
 }
 
+void createFolder(const std::string& path, const std::string& what)
+{
+	std::error_code ec;
+	std::filesystem::create_directories(path, ec);
+	if (!ec && std::filesystem::is_directory(path, ec)) return;
+	throw std::runtime_error(
+		path + ": cannot create " + what + ": " +
+		(ec ? ec.message() : std::string("a file of that name is in the way")));
+}
+
 }  // namespace codemark

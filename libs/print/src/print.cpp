@@ -195,14 +195,8 @@ PrintReport run(const PrintOptions& o, std::ostream* log)
 	const LandmarkGeometry g = geometryOf(o);
 
 	const fs::path dir(o.out_dir);
+	createFolder(o.out_dir, "the output folder");
 	std::error_code ec;
-	if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-		throw std::runtime_error("--out '" + o.out_dir + "' exists and is not a folder");
-	fs::create_directories(dir, ec);
-	if (ec || !fs::is_directory(dir))
-		throw std::runtime_error(
-			"cannot create output folder '" + o.out_dir +
-			"': " + (ec ? ec.message() : std::string("not a folder")));
 	{
 		const fs::path probe = dir / ".codemark-print-write-test";
 		std::ofstream f(probe);

@@ -383,14 +383,8 @@ DatasetSummary writeDataset(
 		o.camera_file.empty() ? CameraModel::paperDefault() : CameraModel::load(o.camera_file);
 	const CPose3D cam_on_robot = o.cameraPoseOnRobot();
 
-	// With its missing parents (mrpt::system::createDirectory() makes one level).
 	const std::string img_dir = out_dir + "/dataset_Images";
-	std::error_code ec;
-	std::filesystem::create_directories(img_dir, ec);
-	if (ec || !std::filesystem::is_directory(img_dir))
-		throw std::runtime_error(
-			img_dir + ": cannot create the output directory: " +
-			(ec ? ec.message() : std::string("not a folder")));
+	createFolder(img_dir, "the output folder");
 
 	reseedMrptRandom(o.seed);
 	const Trajectory trajectory(o);

@@ -816,11 +816,8 @@ std::string povrayCachedRender(
 		throw std::runtime_error(
 			"povray: program '" + pov.executable +
 			"' not found (install POV-Ray 3.7: apt-get install povray)");
+	createFolder(dir.string(), "the POV-Ray cache");
 	std::error_code ec;
-	fs::create_directories(dir, ec);
-	if (ec)
-		throw std::runtime_error(
-			dir.string() + ": cannot create the POV-Ray cache: " + ec.message());
 
 	// POV-Ray's I/O restrictions allow the working directory: render there
 	// under a name of this process, then rename (atomic for readers).

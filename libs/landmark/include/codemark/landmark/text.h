@@ -1,7 +1,8 @@
 #pragma once
 /** \file text.h
  * Reading the project's plain-text tables (map files, trajectories, ground
- * truth, pose lists): strict numbers, and errors that name the file and line.
+ * truth, pose lists): strict numbers, and errors that name the file and line;
+ * output folders made with their parents.
  */
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -79,5 +80,11 @@ std::string oneLineMessage(const std::string& what);
  * validators); one line (MRPT's banner and call stack dropped). A message
  * that already begins with another existing file's path is kept as is. */
 [[noreturn]] void rethrowNamingIniFile(const std::string& file);
+
+/** Creates the folder \a path with its missing parents (an existing folder
+ * is fine; mrpt::system::createDirectory() makes one level only). Throws
+ * std::runtime_error "PATH: cannot create WHAT: REASON", REASON the
+ * system's, or "a file of that name is in the way". */
+void createFolder(const std::string& path, const std::string& what);
 
 }  // namespace codemark
