@@ -137,7 +137,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-annotate: " << e.error() << " (" << e.argId() << ")\n";
+		std::cerr << codemark::app::argumentError("codemark-annotate", e) << "\n";
 	}
 	catch (const std::exception& e)
 	{

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "bench.h"
+#include "errors.h"
 #include "progress.h"
 
 namespace fs = std::filesystem;
@@ -203,10 +204,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		const std::string id = e.argId();
-		const bool named = id.find_first_not_of(' ') != std::string::npos;
-		std::cerr << "codemark-bench: " << (named ? id + ": " : "") << e.error()
-				  << " (see --help)\n";
+		std::cerr << codemark::app::argumentError("codemark-bench", e) << "\n";
 	}
 	catch (const std::exception& e)
 	{

@@ -183,7 +183,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-calibrate-noise: " << e.error() << " (" << e.argId() << ")\n";
+		std::cerr << codemark::app::argumentError("codemark-calibrate-noise", e) << "\n";
 		return 2;
 	}
 	catch (const std::exception& e)

@@ -4,6 +4,7 @@
  * section 5). Parses the command line and calls codemark::detect::detect().
  */
 #include "calibration.h"
+#include "errors.h"
 #include <codemark/detect/colour.h>
 #include <codemark/detect/detector.h>
 #include <codemark/detect/json.h>
@@ -395,8 +396,13 @@ int main(int argc, char** argv)
 		r.draw_dir = draw_arg.getValue();
 		r.debug_dir = debug_arg.getValue();
 		r.colour_report = colour_arg.getValue();
-		if (!r.draw_dir.empty()) fs::create_directories(r.draw_dir);
-		if (!r.debug_dir.empty()) fs::create_directories(r.debug_dir);
+		// The inputs take every word TCLAP does not know: a mistyped option
+		// (no file of that name) is one, not an unreadable image.
+		for (const auto& in : inputs_arg.getValue())
+			if (in.size() > 1 && in[0] == '-' && !fs::exists(in))
+				throw TCLAP::CmdLineParseException("Couldn't find match for argument", in);
+		if (!r.draw_dir.empty()) codemark::createFolder(r.draw_dir, "the --draw folder");
+		if (!r.debug_dir.empty()) codemark::createFolder(r.debug_dir, "the --debug-dir folder");
 		// Warm up once, so that the first image's time_ms does not carry
 		// OpenCV's one-time initialisation and the detector's colour table.
 		{
@@ -414,12 +420,12 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "error: " << e.error() << " for " << e.argId() << "\n";
+		std::cerr << codemark::app::argumentError("codemark-detect", e) << "\n";
 		return 2;
 	}
 	catch (const std::exception& e)
 	{
-		std::cerr << "error: " << e.what() << "\n";
+		std::cerr << "codemark-detect: error: " << codemark::app::oneLine(e) << "\n";
 		return 1;
 	}
 }

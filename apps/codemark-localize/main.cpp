@@ -177,7 +177,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-localize: " << e.error() << " (" << e.argId() << ")\n";
+		std::cerr << codemark::app::argumentError("codemark-localize", e) << "\n";
 	}
 	catch (const std::exception& e)
 	{

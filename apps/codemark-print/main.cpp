@@ -93,8 +93,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-print: error: " << e.argId() << ": " << e.error()
-				  << " (see --help)\n";
+		std::cerr << codemark::app::argumentError("codemark-print", e) << "\n";
 		return 1;
 	}
 	catch (const std::exception& e)

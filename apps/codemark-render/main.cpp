@@ -222,8 +222,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-render: error: " << e.error() << " (argument " << e.argId()
-				  << "); see --help\n";
+		std::cerr << codemark::app::argumentError("codemark-render", e) << "\n";
 		return 1;
 	}
 	catch (const std::exception& e)

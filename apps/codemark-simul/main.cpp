@@ -86,7 +86,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-simul: " << e.error() << " (" << e.argId() << ")\n";
+		std::cerr << codemark::app::argumentError("codemark-simul", e) << "\n";
 	}
 	catch (const std::exception& e)
 	{

@@ -6,6 +6,7 @@
 #include <codemark/eval/uncertainty_figure.h>
 #include <codemark/pose/uncertainty.h>
 #include "calibration.h"
+#include "errors.h"
 
 #include <tclap/CmdLine.h>
 
@@ -179,8 +180,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "codemark-uncertainty: error: " << e.argId() << ": " << e.error()
-				  << " (see --help)\n";
+		std::cerr << codemark::app::argumentError("codemark-uncertainty", e) << "\n";
 		return 1;
 	}
 	catch (const std::exception& e)

@@ -6,6 +6,7 @@
  * stderr that names what is wrong and where.
  */
 #include <codemark/landmark/text.h>
+#include <tclap/ArgException.h>
 
 #include <exception>
 #include <string>
@@ -26,5 +27,16 @@ inline std::string printable(std::string s)
 	for (auto& c : s)
 		if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
 	return s;
+}
+/** TCLAP's complaint about the command line on one line, the same in every
+ * tool: "TOOL: error: ARG: WHAT (see --help)", ARG left out where TCLAP names
+ * none (a missing required argument is named in WHAT). */
+inline std::string argumentError(const std::string& tool, const TCLAP::ArgException& e)
+{
+	std::string id = e.argId();
+	const std::string prefix = "Argument: ";
+	if (id.rfind(prefix, 0) == 0) id.erase(0, prefix.size());
+	const bool named = id.find_first_not_of(' ') != std::string::npos;
+	return tool + ": error: " + (named ? id + ": " : "") + e.error() + " (see --help)";
 }
 }  // namespace codemark::app
