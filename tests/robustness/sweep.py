@@ -288,6 +288,16 @@ case("codemark-bench", "config_missing", ["{d}/does_not_exist.ini"], "does_not_e
 case("codemark-bench", "config_empty", ["{d}/empty.ini"], "empty.ini")
 
 
+# Every app: a mistyped option, named on one line in the tools' common form,
+# and (where arguments are required) none at all.
+for app in ["codemark-print", "codemark-render", "codemark-detect", "codemark-annotate", "codemark-localize",
+            "codemark-simul", "codemark-uncertainty", "codemark-calibrate-noise", "codemark-bench"]:
+    case(app, "unknown_option", ["--no-such-option"],
+         "^%s: error: --no-such-option: .*\\(see --help\\)$" % app)
+    if app != "codemark-uncertainty":
+        case(app, "no_arguments", [], "^%s: error: Required argument.*\\(see --help\\)$" % app)
+
+
 # ------------------------------------------------------------------ check
 def check(bin_dir, d, name):
     app, args, expect, where = CASES[name]
