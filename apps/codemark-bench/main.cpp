@@ -163,6 +163,7 @@ int main(int argc, char** argv)
 			}
 		};
 		std::vector<std::thread> pool;
+		pool.reserve(static_cast<std::size_t>(nthreads));
 		for (int i = 0; i < nthreads; ++i) pool.emplace_back(worker);
 		for (auto& t : pool) t.join();
 		bar.finish();
