@@ -7,7 +7,6 @@
 
 #include <condition_variable>
 #include <chrono>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -18,7 +17,6 @@
 #include "errors.h"
 #include "progress.h"
 
-namespace fs = std::filesystem;
 using namespace codemark::bench;
 
 namespace

@@ -399,7 +399,7 @@ int main(int argc, char** argv)
 		// The inputs take every word TCLAP does not know: a mistyped option
 		// (no file of that name) is one, not an unreadable image.
 		for (const auto& in : inputs_arg.getValue())
-			if (in.size() > 1 && in[0] == '-' && !fs::exists(in))
+			if (std::error_code ec; in.size() > 1 && in[0] == '-' && !fs::exists(in, ec))
 				throw TCLAP::CmdLineParseException("Couldn't find match for argument", in);
 		if (!r.draw_dir.empty()) codemark::createFolder(r.draw_dir, "the --draw folder");
 		if (!r.debug_dir.empty()) codemark::createFolder(r.debug_dir, "the --debug-dir folder");

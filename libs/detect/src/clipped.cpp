@@ -734,15 +734,15 @@ bool imputeClippedSide(
 	// and the outside levels.
 	std::vector<int> fixed;
 	if (!M.outer) fixed = {kW0, kW1, kOutside};
-	// The side's negative log-likelihood, its gradient and Gauss-Newton
-	// Hessian; sn the pixel noise; the sum of squares of the unclipped
-	// residuals through ss, nss.
 	// The Gauss-Newton Hessian is the product of the stacked weighted
 	// Jacobian rows, formed in one blocked rank-k update: a rank-1 update
 	// per sample and channel costs several times more.
 	int rows_max = 0;
 	for (const Window& w : windows) rows_max += (w.i1 - w.i0 + 1) * kChannels;
 	Eigen::Matrix<double, Eigen::Dynamic, kParams> rows(rows_max, kParams);
+	// The side's negative log-likelihood, its gradient and Gauss-Newton
+	// Hessian; sn the pixel noise; the sum of squares of the unclipped
+	// residuals through ss, nss.
 	const auto evaluate = [&](const Vec& q, double sn, Vec* g, Mat* H, double* ss, int* nss)
 	{
 		double nll = 0;

@@ -25,7 +25,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <opencv2/imgcodecs.hpp>
@@ -37,7 +36,6 @@ namespace codemark::eval
 {
 using namespace codemark::filters;
 
-namespace fs = std::filesystem;
 using mrpt::poses::CPose2D;
 
 mrpt::poses::CPose2D alignSE2(

@@ -10,8 +10,6 @@
 #include <mrpt/random/RandomGenerators.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <filesystem>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
