@@ -633,9 +633,13 @@ TEST(Renders, EdgeBendAndItsScatterAreMeasured)
 						EXPECT_GT(q.edge_bend_se_px, 0) << what.str();
 						EXPECT_LT(q.edge_bend_se_px, 0.1) << what.str();
 						if (!noisy && curve == Transfer::Linear)
+						{
 							EXPECT_LT(std::abs(q.edge_bend_px), 0.08) << what.str();
+						}
 						if (!noisy && curve == Transfer::SRGB)
+						{
 							EXPECT_GT(q.edge_bend_px, 0.15) << what.str();
+						}
 						se_sum[noisy] += q.edge_bend_se_px;
 					}
 		}
