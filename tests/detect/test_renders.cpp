@@ -601,6 +601,50 @@ TEST(Renders, BandMidlineUndoesTheTransferCurvesBend)
 		}
 }
 
+// From about 2 m the frame narrows to 6-8 px, closer to each of its edges
+// than the centroid's full window, and a camera's sharpening puts a lobe
+// beside each edge: the band edges' centroid stops short of the frame's far
+// edge (its reach falls with the frame's width), which keeps the midline's
+// edges within a few hundredths of a pixel (each edge's mean outward shift
+// on the midline over eight views per curve and distance, squarely and at
+// 30 deg, through a phone's sharpening; their RMS over the curves and
+// distances).
+TEST(Renders, BandMidlineOnANarrowFrameUnderSharpening)
+{
+	using sim::Transfer;
+	double square = 0;
+	int cases = 0;
+	for (const Transfer curve : {Transfer::SRGB, Transfer::Gamma, Transfer::Filmic})
+		for (const double dist : {2.0, 2.25, 2.5})
+		{
+			double grow = 0;
+			int n = 0;
+			for (const double angle : {0.0, 30.0})
+				for (int k = 0; k < 4; ++k, ++n)
+				{
+					auto o = nominalRender();
+					o.transfer = curve;
+					o.unsharp_amount = 0.9;
+					o.jpeg_quality = 90;
+					const Shot s =
+						shoot((n * 41 + 7) % 256, dist, angle * kDeg, o, 1700 + n, 0.03 * (k - 1));
+					const auto& t = s.render.truth[0];
+					ASSERT_TRUE(t.fully_visible);
+					grow += edgeGrowth(s.render.image, CameraModel(), SubpixelModels(), t.P);
+				}
+			const double with = grow / n;
+			std::printf(
+				"[ narrow bend ] curve %d at %.2f m: each edge %.4f px outwards on the midline\n",
+				static_cast<int>(curve), dist, with);
+			EXPECT_LT(std::abs(with), 0.1) << static_cast<int>(curve) << " at " << dist << " m";
+			square += with * with;
+			++cases;
+		}
+	const double rms = std::sqrt(square / cases);
+	std::printf("[ narrow bend ] RMS %.4f px\n", rms);
+	EXPECT_LT(rms, 0.045);
+}
+
 // DetectionQuality::edge_bend_px and edge_bend_se_px, which the scatter
 // model of C_P reads (pose::PoseOptions::band_ratio_x): the bend is about 0
 // in linear light and a few tenths of a pixel outwards through a transfer

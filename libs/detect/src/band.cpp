@@ -75,6 +75,23 @@ EdgeMode bandLocator(double frame_px, const SubpixelParams& p)
 	return frame_px >= p.min_frame_px_centroid ? EdgeMode::Centroid : EdgeMode::Peak;
 }
 
+/** The centroid's reach either side of each band edge's peak [px]: at
+ * most p.reach_px, and short of the frame's far edge. The frame (the
+ * narrower dark bar, 20 of 200) puts its far edge frame_px from the band's
+ * inner edge; that edge's response spreads up to p.reach_px towards it,
+ * and the discrete derivative one sample more, so a window reaching
+ * further sums the far edge's response (of the opposite sign, with the
+ * lobes of a camera's sharpening) into the near edge's and moves it by a
+ * share of that. Both edges take the same reach, so that a symmetric blur
+ * moves them alike and the band's midline cancels it. At least 2 samples
+ * (where p.reach_px allows): the peak's neighbours carry most of a blurred
+ * edge's response. */
+int bandReach(double frame_px, const SubpixelParams& p)
+{
+	const int clear = static_cast<int>(std::floor(frame_px)) - p.reach_px - 1;
+	return std::min(p.reach_px, std::max(2, clear));
+}
+
 /** Whether the bands read wider or narrower than printed beyond their
  * own scatter: \a excess holds each profile's measured minus predicted
  * band width [px]; its median must lie at least kMinZ of its standard
@@ -209,6 +226,8 @@ bool centreOnBandOnce(
 					c_last >= (along == 1 ? W : H))
 					continue;
 				const EdgeMode mode = bandLocator(frame_px, p);
+				SubpixelParams pb = p;
+				pb.reach_px = bandReach(frame_px, p);
 				// The side's channel (lumaIsSharper()) where the centroid
 				// reads the band.
 				const bool luma =
@@ -231,11 +250,11 @@ bool centreOnBandOnce(
 				const double cell_px = next_green ? width * cell / depth : 0;
 				const auto e_in = locateRisingEdge(
 					v.data(), n, std::max(1, ki - kSearch), std::min(n - 2, ki + kSearch), min_rise,
-					p, mode, frame_px);
+					pb, mode, frame_px);
 				vr.assign(v.rbegin(), v.rend());
 				const auto e_cell_r = locateRisingEdge(
 					vr.data(), n, std::max(1, kc - kSearch), std::min(n - 2, kc + kSearch),
-					min_rise, p, mode, cell_px);
+					min_rise, pb, mode, cell_px);
 				if (!e_in || !e_cell_r) continue;
 				const double e_cell = n - 1 - *e_cell_r;
 				const double measured = e_cell - *e_in;
