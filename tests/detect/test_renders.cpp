@@ -645,6 +645,47 @@ TEST(Renders, BandMidlineOnANarrowFrameUnderSharpening)
 	EXPECT_LT(rms, 0.045);
 }
 
+// A fill well above the sensor's top under a wide blur, encoded through
+// sRGB, bends each edge by more than a pixel: the bands' centring takes
+// all of it (each edge's mean outward shift over four views, read alone
+// and on the midline), where a side's move limited to a pixel would leave
+// most of it.
+TEST(Renders, BandMidlineTakesABendOfOverAPixel)
+{
+	for (const double gain : {1.6, 2.0})
+		for (const double dist : {1.5, 2.25})
+		{
+			double grow[2] = {0, 0};
+			int n = 0;
+			for (int k = 0; k < 4; ++k, ++n)
+			{
+				auto o = nominalRender();
+				o.transfer = sim::Transfer::SRGB;
+				o.gain = gain;
+				o.blur_sigma_px = 1.5;
+				o.jpeg_quality = 90;
+				const Shot s =
+					shoot((n * 41 + 7) % 256, dist, 20 * kDeg, o, 1900 + n, 0.03 * (k - 1));
+				const auto& t = s.render.truth[0];
+				ASSERT_TRUE(t.fully_visible);
+				for (const bool midline : {false, true})
+				{
+					SubpixelModels models;
+					models.band_midline = midline;
+					grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
+				}
+			}
+			const double without = grow[0] / n, with = grow[1] / n;
+			std::ostringstream what;
+			what << "gain " << gain << " at " << dist << " m: each edge " << without
+				 << " px outwards read alone, " << with << " px on the midline";
+			std::printf("[ big bend ] %s\n", what.str().c_str());
+			SCOPED_TRACE(what.str());
+			EXPECT_GT(without, 1.0);
+			EXPECT_LT(std::abs(with), 0.15);
+		}
+}
+
 // DetectionQuality::edge_bend_px and edge_bend_se_px, which the scatter
 // model of C_P reads (pose::PoseOptions::band_ratio_x): the bend is about 0
 // in linear light and a few tenths of a pixel outwards through a transfer

@@ -60,8 +60,11 @@ constexpr double kMinZ = 3;
 /** Fewest profiles for a side's offset. */
 constexpr int kMinProfiles = 3;
 /** The largest move of a side [px]: a camera bends an edge by a few
- * tenths of a pixel; more is a misread band (a cell taken for black). */
-constexpr double kMaxMovePx = 1.0;
+ * tenths of a pixel, by up to about 1.6 px where a fill clipped at twice
+ * the sensor's top meets a 1.5 px blur; a misread band (a cell taken for
+ * black) moves it by half a cell or more, 2.8 px on the smallest square
+ * detected (30 px). */
+constexpr double kMaxMovePx = 2.0;
 
 /** The locator of both band edges: as the single-edge policy reads a
  * side (chooseLocator()), the response's centroid where the frame, the
