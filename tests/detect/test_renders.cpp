@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -71,6 +73,35 @@ double edgeGrowth(
 	if (r.landmarks.size() != 1) return std::nan("");
 	const Eigen::Vector4d e = r.landmarks[0].P - truth_P;
 	return 0.25 * (e[2] - e[0] + e[1] + e[3]);
+}
+
+/** Each edge's mean outward shift [px] read alone ([0]) and on the green
+ * band's midline ([1]) (edgeGrowth()) over views of one landmark rendered
+ * with \a o from \a dist_m: \a per_angle views at each of \a angles_deg,
+ * the landmark \a bearing_step_rad of bearing apart between them, seeds
+ * from \a seed. */
+std::array<double, 2> midlineGrowth(
+	const sim::RenderOptions& o, double dist_m, std::initializer_list<double> angles_deg,
+	int per_angle, double bearing_step_rad, uint64_t seed)
+{
+	std::array<double, 2> grow{0, 0};
+	int n = 0;
+	for (const double angle : angles_deg)
+		for (int k = 0; k < per_angle; ++k, ++n)
+		{
+			const Shot s = shoot(
+				(n * 41 + 7) % 256, dist_m, angle * kDeg, o, seed + n, bearing_step_rad * (k - 1));
+			const auto& t = s.render.truth[0];
+			EXPECT_TRUE(t.fully_visible);
+			for (const bool midline : {false, true})
+			{
+				SubpixelModels models;
+				models.band_midline = midline;
+				grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
+			}
+		}
+	for (double& g : grow) g /= std::max(1, n);
+	return grow;
 }
 }  // namespace
 
@@ -569,27 +600,12 @@ TEST(Renders, BandMidlineUndoesTheTransferCurvesBend)
 	for (const Transfer curve : {Transfer::SRGB, Transfer::Gamma, Transfer::Filmic})
 		for (const double dist : {1.0, 2.0})
 		{
-			double grow[2] = {0, 0};
-			int n = 0;
-			for (const double angle : {0.0, 30.0})
-				for (int k = 0; k < 3; ++k, ++n)
-				{
-					auto o = nominalRender();
-					o.transfer = curve;
-					o.unsharp_amount = 0.5;
-					o.jpeg_quality = 90;
-					const Shot s =
-						shoot((n * 53 + 11) % 256, dist, angle * kDeg, o, 1300 + n, 0.04 * (k - 1));
-					const auto& t = s.render.truth[0];
-					ASSERT_TRUE(t.fully_visible);
-					for (const bool midline : {false, true})
-					{
-						SubpixelModels models;
-						models.band_midline = midline;
-						grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
-					}
-				}
-			const double without = grow[0] / n, with = grow[1] / n;
+			auto o = nominalRender();
+			o.transfer = curve;
+			o.unsharp_amount = 0.5;
+			o.jpeg_quality = 90;
+			const auto grow = midlineGrowth(o, dist, {0.0, 30.0}, 3, 0.04, 1300);
+			const double without = grow[0], with = grow[1];
 			std::ostringstream what;
 			what << "curve " << static_cast<int>(curve) << " at " << dist << " m: each edge "
 				 << without << " px outwards read alone, " << with << " px on the midline";
@@ -617,25 +633,17 @@ TEST(Renders, BandMidlineOnANarrowFrameUnderSharpening)
 	for (const Transfer curve : {Transfer::SRGB, Transfer::Gamma, Transfer::Filmic})
 		for (const double dist : {2.0, 2.25, 2.5})
 		{
-			double grow = 0;
-			int n = 0;
-			for (const double angle : {0.0, 30.0})
-				for (int k = 0; k < 4; ++k, ++n)
-				{
-					auto o = nominalRender();
-					o.transfer = curve;
-					o.unsharp_amount = 0.9;
-					o.jpeg_quality = 90;
-					const Shot s =
-						shoot((n * 41 + 7) % 256, dist, angle * kDeg, o, 1700 + n, 0.03 * (k - 1));
-					const auto& t = s.render.truth[0];
-					ASSERT_TRUE(t.fully_visible);
-					grow += edgeGrowth(s.render.image, CameraModel(), SubpixelModels(), t.P);
-				}
-			const double with = grow / n;
+			auto o = nominalRender();
+			o.transfer = curve;
+			o.unsharp_amount = 0.9;
+			o.jpeg_quality = 90;
+			const auto grow = midlineGrowth(o, dist, {0.0, 30.0}, 4, 0.03, 1700);
+			const double with = grow[1];
 			std::printf(
-				"[ narrow bend ] curve %d at %.2f m: each edge %.4f px outwards on the midline\n",
-				static_cast<int>(curve), dist, with);
+				"[ narrow bend ] curve %d at %.2f m: each edge %.4f px outwards read alone, %.4f "
+				"px "
+				"on the midline\n",
+				static_cast<int>(curve), dist, grow[0], with);
 			EXPECT_LT(std::abs(with), 0.1) << static_cast<int>(curve) << " at " << dist << " m";
 			square += with * with;
 			++cases;
@@ -655,27 +663,13 @@ TEST(Renders, BandMidlineTakesABendOfOverAPixel)
 	for (const double gain : {1.6, 2.0})
 		for (const double dist : {1.5, 2.25})
 		{
-			double grow[2] = {0, 0};
-			int n = 0;
-			for (int k = 0; k < 4; ++k, ++n)
-			{
-				auto o = nominalRender();
-				o.transfer = sim::Transfer::SRGB;
-				o.gain = gain;
-				o.blur_sigma_px = 1.5;
-				o.jpeg_quality = 90;
-				const Shot s =
-					shoot((n * 41 + 7) % 256, dist, 20 * kDeg, o, 1900 + n, 0.03 * (k - 1));
-				const auto& t = s.render.truth[0];
-				ASSERT_TRUE(t.fully_visible);
-				for (const bool midline : {false, true})
-				{
-					SubpixelModels models;
-					models.band_midline = midline;
-					grow[midline] += edgeGrowth(s.render.image, CameraModel(), models, t.P);
-				}
-			}
-			const double without = grow[0] / n, with = grow[1] / n;
+			auto o = nominalRender();
+			o.transfer = sim::Transfer::SRGB;
+			o.gain = gain;
+			o.blur_sigma_px = 1.5;
+			o.jpeg_quality = 90;
+			const auto grow = midlineGrowth(o, dist, {20.0}, 4, 0.03, 1900);
+			const double without = grow[0], with = grow[1];
 			std::ostringstream what;
 			what << "gain " << gain << " at " << dist << " m: each edge " << without
 				 << " px outwards read alone, " << with << " px on the midline";
