@@ -640,9 +640,8 @@ TEST(Renders, BandMidlineOnANarrowFrameUnderSharpening)
 			const auto grow = midlineGrowth(o, dist, {0.0, 30.0}, 4, 0.03, 1700);
 			const double with = grow[1];
 			std::printf(
-				"[ narrow bend ] curve %d at %.2f m: each edge %.4f px outwards read alone, %.4f "
-				"px "
-				"on the midline\n",
+				"[ narrow bend ] curve %d at %.2f m: each edge %.4f px outwards read alone, "
+				"%.4f px on the midline\n",
 				static_cast<int>(curve), dist, grow[0], with);
 			EXPECT_LT(std::abs(with), 0.1) << static_cast<int>(curve) << " at " << dist << " m";
 			square += with * with;

@@ -172,6 +172,9 @@ bool centreOnBandOnce(
 	// pair neighbouring profiles (correlationInflation()).
 	std::vector<int> run_of, pos_of;
 	std::vector<int> v, vr;
+	// The band edges' locator settings: p with its reach (bandReach()) set
+	// per profile.
+	SubpixelParams pb = p;
 	const auto g_at = [&](const Eigen::Vector2d& f)
 	{
 		const Eigen::Vector2d px = map(f);
@@ -229,7 +232,6 @@ bool centreOnBandOnce(
 					c_last >= (along == 1 ? W : H))
 					continue;
 				const EdgeMode mode = bandLocator(frame_px, p);
-				SubpixelParams pb = p;
 				pb.reach_px = bandReach(frame_px, p);
 				// The side's channel (lumaIsSharper()) where the centroid
 				// reads the band.
