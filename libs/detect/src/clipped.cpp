@@ -79,43 +79,46 @@ constexpr size_t kMaxProfiles = 20;
 double Phi(double u) { return 0.5 * std::erfc(-u / kSqrt2); }
 double phi(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
 
+/** normalCdfPdf()'s table: Phi, phi and phi' = -z phi every 1/32 over
+ * [-8.5, 8.5], built when the library loads (a function-local static
+ * would test its guard at every call of that inner-loop function). */
+constexpr double kCdfEnd = 8.5, kCdfPerUnit = 32, kCdfH = 1 / kCdfPerUnit;
+constexpr int kCdfNodes = static_cast<int>(2 * kCdfEnd * kCdfPerUnit) + 1;
+struct CdfNode
+{
+	double P, f, df;
+};
+const std::array<CdfNode, kCdfNodes> kCdfTable = []
+{
+	std::array<CdfNode, kCdfNodes> t{};
+	for (int k = 0; k < kCdfNodes; ++k)
+	{
+		const double u = -kCdfEnd + k * kCdfH;
+		t[k] = {Phi(u), phi(u), -u * phi(u)};
+	}
+	return t;
+}();
+
 /** The standard normal's CDF \a P and density \a f at \a z by cubic
- * Hermite interpolation in a table of both (and of their derivatives f and
- * -z f) every 1/32 over [-8.5, 8.5]: |error| < 5e-9 in either, with no
+ * Hermite interpolation in kCdfTable: |error| < 5e-9 in either, with no
  * exponential or division. Written by hand: std::erfc beside std::exp cost
  * several times as much, and pixelSteps() is where the thin-frame and
  * step-peak fits spend most of their time. Beyond |z| = 8.5 the tails are
  * 0 and 1 to 1e-17. */
 inline void normalCdfPdf(double z, double& P, double& f)
 {
-	constexpr double kEnd = 8.5, kPerUnit = 32, kH = 1 / kPerUnit;
-	constexpr int kNodes = static_cast<int>(2 * kEnd * kPerUnit) + 1;
-	struct Node
-	{
-		double P, f, df;  // Phi, phi and phi' = -z phi at the node
-	};
-	static const std::array<Node, kNodes> table = []
-	{
-		std::array<Node, kNodes> t{};
-		for (int k = 0; k < kNodes; ++k)
-		{
-			const double u = -kEnd + k * kH;
-			t[k] = {Phi(u), phi(u), -u * phi(u)};
-		}
-		return t;
-	}();
-	if (!(std::abs(z) < kEnd))
+	if (!(std::abs(z) < kCdfEnd))
 	{
 		P = z > 0 ? 1.0 : 0.0;
 		f = 0;
 		return;
 	}
-	const double u = (z + kEnd) * kPerUnit;
-	const int k = std::min(static_cast<int>(u), kNodes - 2);
+	const double u = (z + kCdfEnd) * kCdfPerUnit;
+	const int k = std::min(static_cast<int>(u), kCdfNodes - 2);
 	const double s = u - k, r = 1 - s;
 	const double h00 = (1 + 2 * s) * r * r, h01 = s * s * (3 - 2 * s);
-	const double h10 = kH * s * r * r, h11 = -kH * s * s * r;
-	const Node &a = table[k], &b = table[k + 1];
+	const double h10 = kCdfH * s * r * r, h11 = -kCdfH * s * s * r;
+	const CdfNode &a = kCdfTable[k], &b = kCdfTable[k + 1];
 	P = h00 * a.P + h01 * b.P + h10 * a.f + h11 * b.f;
 	f = h00 * a.f + h01 * b.f + h10 * a.df + h11 * b.df;
 }

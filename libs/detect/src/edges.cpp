@@ -8,6 +8,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace codemark::detect
@@ -104,6 +106,10 @@ EdgelMap findEdgels(
 	const int t2 = t * t;
 	const int W = g.cols, H = g.rows;
 	m.polarity = cv::Mat::zeros(H, W, CV_8UC1);
+	// Per row: which pixels' gradients reach the threshold, in a loop the
+	// compiler vectorises; most of a ROI is flat, and the suppression
+	// below then visits only the few that do.
+	std::vector<uint8_t> strong(W, 0);
 	for (int y = 1; y < H - 1; ++y)
 	{
 		const short* ax = gx.ptr<short>(y);
@@ -111,10 +117,18 @@ EdgelMap findEdgels(
 		const short* ay_up = gy.ptr<short>(y - 1);
 		const short* ay_dn = gy.ptr<short>(y + 1);
 		uint8_t* pol = m.polarity.ptr<uint8_t>(y);
+		int any = 0;
+		for (int x = 0; x < W; ++x)
+		{
+			const int m2 = int(ax[x]) * ax[x] + int(ay[x]) * ay[x];
+			strong[x] = m2 >= t2;
+			any |= strong[x];
+		}
+		if (!any) continue;
 		for (int x = 1; x < W - 1; ++x)
 		{
+			if (!strong[x]) continue;
 			const int dx = ax[x], dy = ay[x];
-			if (dx * dx + dy * dy < t2) continue;
 			// Non-maximum suppression along the dominant gradient axis, on
 			// the signed component (keeps the two edges of a thin bar apart).
 			if (std::abs(dx) >= std::abs(dy))
@@ -133,33 +147,49 @@ EdgelMap findEdgels(
 	}
 	// Edgel domains: 8-connected flood fill over edgels of one polarity
 	// (hand-written: cv::connectedComponents would need one pass per
-	// polarity and still no second-order moments).
-	cv::Mat seen = cv::Mat::zeros(H, W, CV_8UC1);
+	// polarity and still no second-order moments). The fill clears the
+	// edgels it takes in a copy of the map; the map's outermost rows and
+	// columns hold no edgels, so every neighbour of an edgel lies inside it.
+	cv::Mat unvisited = m.polarity.clone();
+	uint8_t* const base = unvisited.ptr<uint8_t>(0);
+	const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(unvisited.step[0]);
+	// The 8 neighbours in the order the fill visits them (row by row).
+	const int offset_x[8] = {-1, 0, 1, -1, 1, -1, 0, 1}, offset_y[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+	std::ptrdiff_t neighbours[8];
+	for (int j = 0; j < 8; ++j) neighbours[j] = offset_y[j] * stride + offset_x[j];
 	std::vector<cv::Point> pts;
 	pts.reserve(256);
 	for (int y = 1; y < H - 1; ++y)
 	{
-		const uint8_t* pol = m.polarity.ptr<uint8_t>(y);
+		const uint8_t* pol = unvisited.ptr<uint8_t>(y);
 		for (int x = 1; x < W - 1; ++x)
 		{
-			if (!pol[x] || seen.at<uint8_t>(y, x)) continue;
+			// Eight pixels at a time past the edgel-free stretches.
+			if (x + 8 <= W - 1)
+			{
+				uint64_t eight = 0;
+				std::memcpy(&eight, pol + x, 8);
+				if (eight == 0)
+				{
+					x += 7;
+					continue;
+				}
+			}
+			if (!pol[x]) continue;
 			const uint8_t cls = pol[x];
 			pts.clear();
 			pts.emplace_back(x, y);
-			seen.at<uint8_t>(y, x) = 1;
+			base[y * stride + x] = 0;
 			for (size_t k = 0; k < pts.size(); ++k)
 			{
 				const cv::Point q = pts[k];
-				for (int oy = -1; oy <= 1; ++oy)
-					for (int ox = -1; ox <= 1; ++ox)
-					{
-						const int xx = q.x + ox, yy = q.y + oy;
-						if (xx < 1 || yy < 1 || xx >= W - 1 || yy >= H - 1) continue;
-						if (m.polarity.at<uint8_t>(yy, xx) != cls || seen.at<uint8_t>(yy, xx))
-							continue;
-						seen.at<uint8_t>(yy, xx) = 1;
-						pts.emplace_back(xx, yy);
-					}
+				uint8_t* const at = base + q.y * stride + q.x;
+				for (int j = 0; j < 8; ++j)
+				{
+					if (at[neighbours[j]] != cls) continue;
+					at[neighbours[j]] = 0;
+					pts.emplace_back(q.x + offset_x[j], q.y + offset_y[j]);
+				}
 			}
 			if (static_cast<int>(pts.size()) < p.min_edgels) continue;
 			EdgelDomain d;
