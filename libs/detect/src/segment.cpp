@@ -396,8 +396,11 @@ std::vector<Candidate> findCandidates(
 		for (size_t i = 0; i < runs.size(); ++i)
 		{
 			if (!keep[run_comp[i]]) continue;
-			const uint8_t* px = bgr.ptr<uint8_t>(runs[i].y * step);
-			for (int x = runs[i].x0; x < runs[i].x1; ++x) sg[run_comp[i]] += px[3 * x * step + 1];
+			const uint8_t* px = bgr.ptr<uint8_t>(runs[i].y * step) + 1;
+			// An integer sum per run (exact, and kept in a register).
+			int run_sum = 0;
+			for (int x = runs[i].x0; x < runs[i].x1; ++x) run_sum += px[3 * x * step];
+			sg[run_comp[i]] += run_sum;
 		}
 		for (auto& c : out) c.fill_g = sg[c.label - 1] / comps[c.label - 1].m0;
 		// Frame evidence: a landmark's fill is surrounded by the dark frame.

@@ -305,13 +305,15 @@ std::optional<double> thinFrameOffset(
 		if (!edges[j]) continue;
 		++used;
 		const int* v = g_profiles.data() + j * n;
-		for (int i = std::max(0, static_cast<int>(std::ceil(*edges[j] + x0)));
-			 i <= std::min(n - 1, static_cast<int>(std::floor(*edges[j] + kInside))); ++i)
+		const double e = *edges[j];
+		const int i0 = std::max(0, static_cast<int>(std::ceil(e + x0))),
+				  i1 = std::min(n - 1, static_cast<int>(std::floor(e + kInside)));
+		for (int i = i0; i <= i1; ++i)
 		{
-			const int b = static_cast<int>((i - *edges[j] - x0) / kBin);
+			const int b = static_cast<int>((i - e - x0) / kBin);
 			if (b < 0 || b >= bins) continue;
 			sum[b] += v[i];
-			sum_x[b] += i - *edges[j];
+			sum_x[b] += i - e;
 			++count[b];
 		}
 	}
