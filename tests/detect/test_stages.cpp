@@ -193,6 +193,44 @@ TEST(Components, HandMadeMask)
 	EXPECT_TRUE(cv::Rect(0, 0, 160, 120).contains(c[0].roi.br() - cv::Point(1, 1)));
 }
 
+TEST(Components, LabelsAreOpenCvsFourConnectedComponents)
+{
+	// Random blobs and specks, runs of every length, some touching the
+	// mask's last column and row (the word-wise scans' ends): the same
+	// partition of the cells as cv::connectedComponents with N4.
+	cv::Mat mask = cv::Mat::zeros(73, 101, CV_8UC1);
+	std::mt19937 rng(3);
+	std::uniform_int_distribution<int> x(0, 100), y(0, 72), w(1, 30);
+	for (int k = 0; k < 40; ++k)
+		cv::rectangle(mask, cv::Rect(x(rng), y(rng), w(rng), w(rng) / 3 + 1), 255, cv::FILLED);
+	for (int k = 0; k < 300; ++k) mask.at<uint8_t>(y(rng), x(rng)) = 1;
+	const cv::Mat img(146, 202, CV_8UC3, kGreen);
+	cv::Mat labels, reference;
+	int n = 0;
+	findCandidates(mask, 2, img, ComponentParams(), &labels, &n);
+	const int n_ref = cv::connectedComponents(mask != 0, reference, 4, CV_32S) - 1;
+	ASSERT_GT(n_ref, 50);
+	EXPECT_EQ(n, n_ref);
+	// One label of ours per reference component and back.
+	std::vector<int> ours_of(n_ref + 1, -1), ref_of(n + 1, -1);
+	int mismatches = 0;
+	for (int r = 0; r < mask.rows; ++r)
+		for (int c = 0; c < mask.cols; ++c)
+		{
+			const int a = labels.at<int>(r, c), b = reference.at<int>(r, c);
+			if ((a == 0) != (b == 0))
+			{
+				++mismatches;
+				continue;
+			}
+			if (a == 0 || a > n || b > n_ref) continue;
+			if (ours_of[b] < 0) ours_of[b] = a;
+			if (ref_of[a] < 0) ref_of[a] = b;
+			mismatches += ours_of[b] != a || ref_of[a] != b;
+		}
+	EXPECT_EQ(mismatches, 0);
+}
+
 TEST(Components, ARingIsCompactEnoughAndALShapeIsNot)
 {
 	cv::Mat mask = cv::Mat::zeros(100, 100, CV_8UC1);
@@ -406,6 +444,51 @@ TEST(Edgels, PolarityOfTheInnerEdges)
 			left_found = true;
 		}
 	EXPECT_TRUE(left_found);
+}
+
+TEST(Edgels, DomainsAreTheEightConnectedEdgelsOfEachPolarity)
+{
+	// A landmark and random bars and specks of other levels: every domain
+	// is an 8-connected component of one polarity's edgels in the map
+	// (cv::connectedComponentsWithStats, one polarity at a time), with its
+	// edgel count and centroid, and every component of at least
+	// min_edgels edgels is a domain.
+	cv::Mat img = craftedLandmark(77);
+	std::mt19937 rng(9);
+	std::uniform_int_distribution<int> at(0, 170), len(2, 40), level(0, 255);
+	for (int k = 0; k < 30; ++k)
+		cv::rectangle(
+			img, cv::Rect(at(rng), at(rng), len(rng), len(rng) / 4 + 1),
+			cv::Scalar(level(rng), level(rng), level(rng)), cv::FILLED);
+	cv::GaussianBlur(img, img, cv::Size(0, 0), 0.7);
+	EdgelParams full;
+	full.max_roi_px = 1000;	 // no reduction: the map's pixels are the image's
+	const cv::Rect roi(7, 11, 160, 150);
+	const auto m = findEdgels(img, roi, 6, full);
+	ASSERT_EQ(m.scale, 1);
+	size_t expected = 0;
+	int unmatched = 0;
+	for (const Polarity pol : {Polarity::Top, Polarity::Right, Polarity::Bottom, Polarity::Left})
+	{
+		cv::Mat labels, stats, centroids;
+		const int n = cv::connectedComponentsWithStats(
+			m.polarity == static_cast<uint8_t>(pol), labels, stats, centroids, 8, CV_32S);
+		for (int l = 1; l < n; ++l)
+		{
+			const int count = stats.at<int>(l, cv::CC_STAT_AREA);
+			if (count < full.min_edgels) continue;
+			++expected;
+			const Eigen::Vector2d mean(
+				roi.x + centroids.at<double>(l, 0), roi.y + centroids.at<double>(l, 1));
+			unmatched += std::none_of(
+				m.domains.begin(), m.domains.end(),
+				[&](const EdgelDomain& d)
+				{ return d.polarity == pol && d.count == count && (d.mean - mean).norm() < 1e-9; });
+		}
+	}
+	EXPECT_GT(expected, 20u);
+	EXPECT_EQ(m.domains.size(), expected);
+	EXPECT_EQ(unmatched, 0);
 }
 
 TEST(Edgels, FlatImageHasNone)
