@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 
 namespace codemark::detect
@@ -162,20 +161,10 @@ EdgelMap findEdgels(
 	for (int y = 1; y < H - 1; ++y)
 	{
 		const uint8_t* pol = unvisited.ptr<uint8_t>(y);
-		for (int x = 1; x < W - 1; ++x)
+		// From one edgel not yet taken to the next.
+		for (int x = firstByteFrom(pol, 1, W - 1, false); x < W - 1;
+			 x = firstByteFrom(pol, x + 1, W - 1, false))
 		{
-			// Eight pixels at a time past the edgel-free stretches.
-			if (x + 8 <= W - 1)
-			{
-				uint64_t eight = 0;
-				std::memcpy(&eight, pol + x, 8);
-				if (eight == 0)
-				{
-					x += 7;
-					continue;
-				}
-			}
-			if (!pol[x]) continue;
 			const uint8_t cls = pol[x];
 			pts.clear();
 			pts.emplace_back(x, y);

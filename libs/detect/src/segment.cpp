@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
 #define CODEMARK_STEP2_KERNEL segmentStep2Baseline
@@ -289,26 +288,10 @@ std::vector<Candidate> findCandidates(
 		int x = 0;
 		while (x < mask.cols)
 		{
-			// Skip empty cells eight at a time.
-			while (x + 8 <= mask.cols)
-			{
-				uint64_t w;
-				std::memcpy(&w, m + x, 8);
-				if (w) break;
-				x += 8;
-			}
-			while (x < mask.cols && !m[x]) ++x;
+			x = firstByteFrom(m, x, mask.cols, false);
 			if (x >= mask.cols) break;
 			const int x0 = x;
-			// Through full cells eight at a time (a word with no zero byte).
-			while (x + 8 <= mask.cols)
-			{
-				uint64_t w;
-				std::memcpy(&w, m + x, 8);
-				if ((w - 0x0101010101010101ull) & ~w & 0x8080808080808080ull) break;
-				x += 8;
-			}
-			while (x < mask.cols && m[x]) ++x;
+			x = firstByteFrom(m, x, mask.cols, true);
 			runs.push_back({y, x0, x, static_cast<int>(runs.size())});
 		}
 		// Union with overlapping runs of the previous row (N4: shared columns).

@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <vector>
 
@@ -230,6 +231,24 @@ enum class EdgeChannel
 inline int lumaLevel(const uint8_t* bgr)
 {
 	return (114 * bgr[0] + 587 * bgr[1] + 299 * bgr[2] + 293) / 587;
+}
+
+/** The first index in [\a x, \a end) of \a row whose byte is non-zero
+ * (\a end if none), or, with \a zero, whose byte is zero: eight bytes at
+ * a time through the stretches without one (a word with no zero byte has
+ * (w - 0x01..01) & ~w & 0x80..80 == 0). The masks and maps the detector
+ * scans are mostly empty, and their runs long. */
+inline int firstByteFrom(const uint8_t* row, int x, int end, bool zero)
+{
+	constexpr uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
+	for (; x + 8 <= end; x += 8)
+	{
+		uint64_t w;
+		std::memcpy(&w, row + x, 8);
+		if (zero ? ((w - kOnes) & ~w & kHighs) != 0 : w != 0) break;
+	}
+	while (x < end && (row[x] == 0) != zero) ++x;
+	return x;
 }
 
 /** How locateRisingEdge() places the edge. */
