@@ -568,6 +568,71 @@ TEST(Renders, ClutterWithoutLandmarksGivesNothing)
 	EXPECT_EQ(found, 0);
 }
 
+// The centre gate (centreMayBeBlack()) reads the code's centre cell
+// through the linked quadrangle's pixel-accurate corners before the
+// sub-pixel stage: it passes every landmark the detector reads, down to 5 m
+// at 60 deg (the smallest cells) through each camera preset, so that the
+// detections with and without it are the same to the bit; and it refuses
+// most of the quadrangles that the clutter's green shapes link.
+TEST(Renders, CentreGateChangesNoDetectionAndRefusesClutter)
+{
+	SubpixelModels without;
+	without.centre_gate = false;
+	const CameraModel cam;
+	const LandmarkGeometry g;
+	const DetectorOptions opt;
+	int views = 0, found = 0;
+	for (const char* preset : {"linear", "webcam", "phone", "family"})
+		for (int k = 0; k < 8; ++k)
+		{
+			auto o = nominalRender();
+			o.applyPreset(preset);
+			const double dist = k < 4 ? 5.0 : 1.0 + 0.5 * k;
+			const Shot s = shoot(
+				(k * 61 + 7) % 256, dist, (k % 2 ? 60 : -55) * kDeg, o, 3100 + k + 10 * views,
+				0.05 * ((k % 5) - 2));
+			const auto with = detectWithModels(s.render.image, cam, g, opt, SubpixelModels());
+			const auto wo = detectWithModels(s.render.image, cam, g, opt, without);
+			SCOPED_TRACE(std::string(preset) + " view " + std::to_string(k));
+			ASSERT_EQ(with.landmarks.size(), wo.landmarks.size());
+			found += static_cast<int>(with.landmarks.size());
+			for (size_t i = 0; i < with.landmarks.size(); ++i)
+			{
+				EXPECT_EQ(with.landmarks[i].detection.id, wo.landmarks[i].detection.id);
+				for (int c = 0; c < 4; ++c)
+					EXPECT_EQ(
+						with.landmarks[i].detection.corners[c],
+						wo.landmarks[i].detection.corners[c]);
+			}
+			++views;
+		}
+	EXPECT_GE(found, views - 2);
+	int linked = 0, fitted_with = 0, fitted_without = 0;
+	for (int k = 0; k < 40; ++k)
+	{
+		sim::Scene sc;
+		MapLandmark lm;
+		lm.id = 1;
+		sc.map.landmarks.push_back(lm);
+		sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
+		auto o = nominalRender();
+		o.background = sim::Background::Cluttered;
+		o.distractors = 12;
+		const auto img = sim::render(sc, o, 2000 + k).image;
+		const auto with = detectWithModels(img, cam, g, opt, SubpixelModels());
+		const auto wo = detectWithModels(img, cam, g, opt, without);
+		EXPECT_TRUE(with.landmarks.empty() && wo.landmarks.empty()) << k;
+		linked += with.counts.quads;
+		fitted_with += with.counts.fitted;
+		fitted_without += wo.counts.fitted;
+	}
+	std::printf(
+		"[ gate ] clutter: %d quadrangles linked, %d fitted without the gate, %d with it\n", linked,
+		fitted_without, fitted_with);
+	ASSERT_GE(fitted_without, 8);
+	EXPECT_LE(fitted_with, fitted_without / 4);
+}
+
 TEST(Renders, GreyOnlyImageGivesNothing)
 {
 	auto o = nominalRender();

@@ -1263,6 +1263,63 @@ TEST(Code, RejectsGreenCentreOtherFillAndMissingFrame)
 	EXPECT_FALSE(readCode(cut, qc, CameraModel(), g, CodeParams()));
 }
 
+// The gate before the sub-pixel stage reads the centre cell at corners a
+// pixel off in any direction: a code board passes, a green centre and a
+// green square without a board do not.
+TEST(Code, CentreGateToleratesAPixelsCornerErrorAndRefusesAGreenCentre)
+{
+	const LandmarkGeometry g;
+	const CodeParams p;
+	const Quad truth = craftedCorners();
+	for (int id = 0; id < 256; id += 51)
+	{
+		const cv::Mat img = craftedLandmark(id, 40, 0.8);
+		cv::Mat green_centre = img.clone();
+		cv::rectangle(green_centre, cv::Rect(40 + 43, 40 + 43, 15, 15), kGreen, cv::FILLED);
+		for (int shift = 0; shift < 16; ++shift)
+		{
+			Quad q = truth;
+			for (int k = 0; k < 4; ++k)
+			{
+				const double a = M_PI / 8 * shift + k * M_PI / 2;
+				q[k] += Eigen::Vector2d(std::cos(a), std::sin(a));
+			}
+			EXPECT_TRUE(centreMayBeBlack(img, q, CameraModel(), g, p)) << id << " " << shift;
+			EXPECT_FALSE(centreMayBeBlack(green_centre, q, CameraModel(), g, p))
+				<< id << " " << shift;
+		}
+	}
+	// A landmark 26 px across (5 m at 60 deg: cells of 5 px), blurred.
+	for (const double blur : {0.6, 1.2})
+	{
+		const int side = 26, o = 30;
+		const cv::Mat small = printedLandmark(side, kGreen, kBlack, kWhite, blur, o, 90);
+		const double a = o - 0.5, b = o + side - 0.5;
+		const Quad corners{
+			Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b),
+			Eigen::Vector2d(a, b)};
+		for (int shift = 0; shift < 16; ++shift)
+		{
+			Quad q = corners;
+			for (int k = 0; k < 4; ++k)
+			{
+				const double t = M_PI / 8 * shift + k * M_PI / 2;
+				q[k] += Eigen::Vector2d(std::cos(t), std::sin(t));
+			}
+			EXPECT_TRUE(centreMayBeBlack(small, q, CameraModel(), g, p)) << blur << " " << shift;
+		}
+	}
+	// A green square on black: a frame, but no code board.
+	cv::Mat square(180, 180, CV_8UC3, kBlack);
+	cv::rectangle(square, cv::Rect(50, 50, 80, 80), kGreen, cv::FILLED);
+	cv::GaussianBlur(square, square, cv::Size(0, 0), 0.8);
+	EXPECT_FALSE(centreMayBeBlack(square, truth, CameraModel(), g, p));
+	// Corners whose patches leave the image: readCode() decides.
+	Quad outside = truth;
+	for (auto& c : outside) c *= 3;
+	EXPECT_TRUE(centreMayBeBlack(square, outside, CameraModel(), g, p));
+}
+
 TEST(Code, TheFrameCheckComparesTheInk)
 {
 	// The dim laser print of FrameEvidenceOfAThinFrame, its corners known:

@@ -146,6 +146,55 @@ std::optional<double> patchMean(const cv::Mat& bgr, const FaceMap& map, const Fa
 	return patchMean(bgr, map, f.centre.x(), f.centre.y(), f.rx, f.ry);
 }
 
+/** The references of the code read, side by side (top, right, bottom,
+ * left): the black frame's mean G midway between its inner and outer edge,
+ * and the green ring's between the code board and the frame, three patches
+ * each along the side's middle. */
+struct SideLevels
+{
+	std::array<double, 4> black{}, green{};
+};
+
+/** SideLevels under \a map; nullopt when a patch leaves the image. */
+std::optional<SideLevels> sideLevels(
+	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo)
+{
+	const double outer = geo.outerHalf() / geo.innerHalf();
+	const double rb = 0.5 * (1 + outer);
+	const double band_b = 0.25 * (outer - 1);
+	SideLevels out;
+	for (int side = 0; side < 4; ++side)
+	{
+		double sb = 0, sg = 0;
+		const int n = 3;
+		for (int k = 0; k < n; ++k)
+		{
+			const double t = -0.5 + 0.5 * k;  // along the side, within its middle
+			const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
+			// Along-side direction is (ny, -nx).
+			const double ax = ny * t, ay = -nx * t;
+			const double rx_b = nx != 0 ? band_b : 0.08, ry_b = ny != 0 ? band_b : 0.08;
+			const auto b = patchMean(bgr, map, nx * rb + ax, ny * rb + ay, rx_b, ry_b);
+			const auto g = patchMean(bgr, map, ringPatch(geo, side, k));
+			if (!b || !g) return std::nullopt;
+			sb += *b;
+			sg += *g;
+		}
+		out.black[side] = sb / n;
+		out.green[side] = sg / n;
+	}
+	return out;
+}
+
+/** The mean of the two smallest of \a x: the frame's level from its two
+ * darkest sides (at an oblique view the foreshortened sides are thin and
+ * blur towards their neighbours). */
+double meanOfTwoSmallest(std::array<double, 4> x)
+{
+	std::sort(x.begin(), x.end());
+	return 0.5 * (x[0] + x[1]);
+}
+
 /** Mean over 5 samples evenly spread over [c - r, c + r] of the Gaussian
  * (std \a s) blurred indicator of [a, b]. */
 double blurredInterval(double a, double b, double c, double r, double s)
@@ -301,47 +350,20 @@ std::optional<CodeReading> readCode(
 		if (!(px.x() >= lo_u && px.x() <= hi_u && px.y() >= lo_v && px.y() <= hi_v))
 			return std::nullopt;
 	}
-	// References: the black frame, midway between its inner and outer edge,
-	// and the green ring between the code board and the frame, side by
-	// side (top, right, bottom, left).
-	const double rb = 0.5 * (1 + outer);
-	const double band_b = 0.25 * (outer - 1);
+	const auto levels = sideLevels(bgr, map, geo);
+	if (!levels) return std::nullopt;
+	const auto& [black, green] = *levels;
 	// The frame's ink, without the fill and the sheet that blur spreads over
 	// it (frameNeighbourShare()): the level the ratio checks compare.
-	std::array<double, 4> black{}, green{}, ink{};
+	std::array<double, 4> ink{};
 	for (int side = 0; side < 4; ++side)
-	{
-		double sb = 0, sg = 0;
-		const int n = 3;
-		for (int k = 0; k < n; ++k)
-		{
-			const double t = -0.5 + 0.5 * k;  // along the side, within its middle
-			const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
-			// Along-side direction is (ny, -nx).
-			const double ax = ny * t, ay = -nx * t;
-			const double rx_b = nx != 0 ? band_b : 0.08, ry_b = ny != 0 ? band_b : 0.08;
-			const auto b = patchMean(bgr, map, nx * rb + ax, ny * rb + ay, rx_b, ry_b);
-			const auto g = patchMean(bgr, map, ringPatch(geo, side, k));
-			if (!b || !g) return std::nullopt;
-			sb += *b;
-			sg += *g;
-		}
-		black[side] = sb / n;
-		green[side] = sg / n;
 		ink[side] = frameSurround(bgr, map, geo, side, frame_blur_px).ink(black[side], green[side]);
-	}
 	CodeReading r;
 	r.green_g = 0.25 * (green[0] + green[1] + green[2] + green[3]);
-	// The two darkest frame sides: at an oblique view the foreshortened
-	// sides are thin and blur towards their neighbours.
-	std::array<double, 4> sorted = black;
-	std::sort(sorted.begin(), sorted.end());
-	r.black_g = 0.5 * (sorted[0] + sorted[1]);
+	r.black_g = meanOfTwoSmallest(black);
 	const double contrast = r.green_g - r.black_g;
 	if (contrast < p.min_contrast) return std::nullopt;
-	std::array<double, 4> ink_sorted = ink;
-	std::sort(ink_sorted.begin(), ink_sorted.end());
-	const double frame_ink = 0.5 * (ink_sorted[0] + ink_sorted[1]);
+	const double frame_ink = meanOfTwoSmallest(ink);
 	if (frame_ink > p.max_black_ratio * r.green_g) return std::nullopt;
 	for (int side = 0; side < 4; ++side)
 		if (ink[side] > p.max_side_black_ratio * green[side] ||
@@ -387,6 +409,21 @@ std::optional<CodeReading> readCode(
 	if (!id) return std::nullopt;
 	r.id = *id;
 	return r;
+}
+
+bool centreMayBeBlack(
+	const cv::Mat& bgr, const Quad& corners_ideal, const CameraModel& cam,
+	const LandmarkGeometry& geo, const CodeParams& p)
+{
+	const FaceMap map{faceToImage(corners_ideal), cam, cam.hasDistortion()};
+	const auto levels = sideLevels(bgr, map, geo);
+	const auto centre = patchMean(bgr, map, cellPatch(geo, 4, p.patch_fraction));
+	// A patch outside the image: readCode() decides on the refined corners.
+	if (!levels || !centre) return true;
+	const auto& [black, green] = *levels;
+	const double green_g = 0.25 * (green[0] + green[1] + green[2] + green[3]);
+	const double contrast = green_g - meanOfTwoSmallest(black);
+	return contrast > 0 && green_g - *centre >= p.min_margin * contrast;
 }
 
 }  // namespace codemark::detect

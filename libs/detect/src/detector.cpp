@@ -91,6 +91,18 @@ DetectionResult detectWithModels(
 		if (!quad) continue;
 		++res.counts.quads;
 
+		// 6b. The code's centre cell at the linked corners: a green surface
+		// that links a quadrangle without a code board is refused before the
+		// sub-pixel stage's work.
+		if (models.centre_gate)
+		{
+			Quad ideal;
+			for (int k = 0; k < 4; ++k) ideal[k] = camera.undistortPixel((*quad)[k]);
+			const bool pass = centreMayBeBlack(bgr, ideal, camera, geometry, opt.code);
+			tm.code_us += microsSince(t);
+			if (!pass) continue;
+		}
+
 		// 7. Sub-pixel edges, a line per side, corners.
 		auto refined = refineQuadrangle(
 			bgr, *quad, camera, thr, frame_ratio, opt.subpixel, fill_ratio, models);

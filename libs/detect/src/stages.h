@@ -175,11 +175,14 @@ using Quad = std::array<Eigen::Vector2d, 4>;
 std::optional<Quad> linkQuadrangle(const SideSegments& s, const QuadParams& p);
 
 // ------------------------------------------------------------------ stage 7
-/** Switches for the sub-pixel stage's models, for the tests and benchmarks
- * that measure what each one does. Not detector options: the detector runs
- * them all. */
+/** Switches for the sub-pixel stage's models and its gate, for the tests
+ * and benchmarks that measure what each one does. Not detector options: the
+ * detector runs them all. */
 struct SubpixelModels
 {
+	/** Stage 6b: refuse a linked quadrangle whose centre cell reads green
+	 * before its sub-pixel work (centreMayBeBlack()). */
+	bool centre_gate = true;
 	/** Restore clipped G samples before the edges are read (imputeFillLevel(),
 	 * imputeClippedSide()). */
 	bool clipping = true;
@@ -683,6 +686,19 @@ std::optional<BlurredCells> readCellsThroughBlur(
 std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
 	const CodeParams& p, double frame_blur_px = ComponentParams().frame_blur_px);
+
+/** The gate before the sub-pixel stage: false when the centre cell, read
+ * through the linked quadrangle's pixel-accurate corners \a corners_ideal
+ * (undistorted), is not darker than the green ring by CodeParams::min_margin
+ * of the ring's contrast to the frame (readCode()'s references and patches),
+ * or the frame is not darker than the ring.
+ * The code's centre is always black and the widest of its patches, far from
+ * every edge that a corner's pixel error moves; the flat green surfaces that
+ * link a quadrangle without a code board read green there. True when a
+ * patch leaves the image (readCode() decides). */
+bool centreMayBeBlack(
+	const cv::Mat& bgr, const Quad& corners_ideal, const CameraModel& camera,
+	const LandmarkGeometry& geometry, const CodeParams& p);
 
 // ---------------------------------------------------------------- detector
 /** detect() with the sub-pixel stage's models switched by \a models (the
