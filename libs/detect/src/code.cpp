@@ -155,9 +155,10 @@ struct SideLevels
 	std::array<double, 4> black{}, green{};
 };
 
-/** SideLevels under \a map; nullopt when a patch leaves the image. */
+/** SideLevels under \a map; nullopt when a patch leaves the image. With
+ * \a middle_only, one patch a side (the middle one) instead of three. */
 std::optional<SideLevels> sideLevels(
-	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo)
+	const cv::Mat& bgr, const FaceMap& map, const LandmarkGeometry& geo, bool middle_only = false)
 {
 	const double outer = geo.outerHalf() / geo.innerHalf();
 	const double rb = 0.5 * (1 + outer);
@@ -166,8 +167,8 @@ std::optional<SideLevels> sideLevels(
 	for (int side = 0; side < 4; ++side)
 	{
 		double sb = 0, sg = 0;
-		const int n = 3;
-		for (int k = 0; k < n; ++k)
+		const int first = middle_only ? 1 : 0, last = middle_only ? 1 : 2;
+		for (int k = first; k <= last; ++k)
 		{
 			const double t = -0.5 + 0.5 * k;  // along the side, within its middle
 			const double nx = kSideNormals[side][0], ny = kSideNormals[side][1];
@@ -180,8 +181,8 @@ std::optional<SideLevels> sideLevels(
 			sb += *b;
 			sg += *g;
 		}
-		out.black[side] = sb / n;
-		out.green[side] = sg / n;
+		out.black[side] = sb / (last - first + 1);
+		out.green[side] = sg / (last - first + 1);
 	}
 	return out;
 }
@@ -416,7 +417,7 @@ bool centreMayBeBlack(
 	const LandmarkGeometry& geo, const CodeParams& p)
 {
 	const FaceMap map{faceToImage(corners_ideal), cam, cam.hasDistortion()};
-	const auto levels = sideLevels(bgr, map, geo);
+	const auto levels = sideLevels(bgr, map, geo, true);
 	const auto centre = patchMean(bgr, map, cellPatch(geo, 4, p.patch_fraction));
 	// A patch outside the image: readCode() decides on the refined corners.
 	if (!levels || !centre) return true;

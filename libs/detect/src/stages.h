@@ -687,15 +687,15 @@ std::optional<CodeReading> readCode(
 	const cv::Mat& bgr, const RefinedQuad& q, const CameraModel& camera, const LandmarkGeometry& g,
 	const CodeParams& p, double frame_blur_px = ComponentParams().frame_blur_px);
 
-/** The gate before the sub-pixel stage: false when the centre cell, read
- * through the linked quadrangle's pixel-accurate corners \a corners_ideal
- * (undistorted), is not darker than the green ring by CodeParams::min_margin
- * of the ring's contrast to the frame (readCode()'s references and patches),
- * or the frame is not darker than the ring.
- * The code's centre is always black and the widest of its patches, far from
- * every edge that a corner's pixel error moves; the flat green surfaces that
- * link a quadrangle without a code board read green there. True when a
- * patch leaves the image (readCode() decides). */
+/** The gate before the sub-pixel stage: false when, read through the linked
+ * quadrangle's pixel-accurate corners \a corners_ideal (undistorted), the
+ * frame is not darker than the green ring, or the centre cell is not darker
+ * than the ring by CodeParams::min_margin of that contrast (readCode()'s
+ * patches; the frame and the ring at each side's middle only). The code's
+ * centre is always black and its patch lies farthest from every edge that
+ * a corner's pixel error moves; the green surfaces that link a quadrangle
+ * without a code board read green there. True when a patch leaves the
+ * image (readCode() decides). */
 bool centreMayBeBlack(
 	const cv::Mat& bgr, const Quad& corners_ideal, const CameraModel& camera,
 	const LandmarkGeometry& geometry, const CodeParams& p);
