@@ -238,9 +238,12 @@ inline int lumaLevel(const uint8_t* bgr)
 
 /** The first index in [\a x, \a end) of \a row whose byte is non-zero
  * (\a end if none), or, with \a zero, whose byte is zero: eight bytes at
- * a time through the stretches without one (a word with no zero byte has
- * (w - 0x01..01) & ~w & 0x80..80 == 0). The masks and maps the detector
- * scans are mostly empty, and their runs long. */
+ * a time (the masks and maps the detector scans are mostly empty, and
+ * their runs long). In a word w, the lowest byte flagged by
+ * (w - 0x01..01) & ~w & 0x80..80 is its first zero byte (a borrow only
+ * flags bytes above a zero one), and the lowest set bit of w lies in its
+ * first non-zero byte: on a little-endian machine the trailing zero bits
+ * over eight give the byte's index. */
 inline int firstByteFrom(const uint8_t* row, int x, int end, bool zero)
 {
 	constexpr uint64_t kOnes = 0x0101010101010101ull, kHighs = 0x8080808080808080ull;
@@ -248,7 +251,12 @@ inline int firstByteFrom(const uint8_t* row, int x, int end, bool zero)
 	{
 		uint64_t w;
 		std::memcpy(&w, row + x, 8);
-		if (zero ? ((w - kOnes) & ~w & kHighs) != 0 : w != 0) break;
+		const uint64_t hit = zero ? (w - kOnes) & ~w & kHighs : w;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+		if (hit != 0) return x + (__builtin_ctzll(hit) >> 3);
+#else
+		if (hit != 0) break;
+#endif
 	}
 	while (x < end && (row[x] == 0) != zero) ++x;
 	return x;
