@@ -380,6 +380,20 @@ std::vector<Candidate> findCandidates(
 		out.push_back(c);
 		keep[l] = 1;
 	}
+	// The code's centre cell: a hole in the fill near the box's centre. It
+	// reads the mask only, so it goes first and spares the fill's mean G
+	// (a pass over every cell of the component) to the green shapes without
+	// one (posters, shapes on a wall).
+	out.erase(
+		std::remove_if(
+			out.begin(), out.end(),
+			[&](const Candidate& c)
+			{
+				if (centreEvidence(mask, c, step, centre_cell_rel, p)) return false;
+				keep[c.label - 1] = 0;
+				return true;
+			}),
+		out.end());
 	// Mean G of each survivor's fill (for the gradient threshold).
 	if (!out.empty())
 	{
@@ -397,15 +411,11 @@ std::vector<Candidate> findCandidates(
 		// Frame evidence: a landmark's fill is surrounded by the dark frame.
 		// Along short rays outwards from each side of the bounding box, the
 		// darkest G must be dark: cheap, and it spares the later stages most
-		// green things of a scene (posters, shapes on a wall).
+		// green things of a scene.
 		out.erase(
 			std::remove_if(
 				out.begin(), out.end(),
-				[&](const Candidate& c)
-				{
-					return !centreEvidence(mask, c, step, centre_cell_rel, p) ||
-						   !frameEvidence(bgr, c, step, frame_rel, p);
-				}),
+				[&](const Candidate& c) { return !frameEvidence(bgr, c, step, frame_rel, p); }),
 			out.end());
 	}
 	std::sort(
