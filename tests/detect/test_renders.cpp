@@ -547,23 +547,31 @@ TEST(Renders, FrameFilledWithAnotherColourIsNotALandmark)
 	}
 }
 
+namespace
+{
+/** Frame \a k of a cluttered wall without a landmark (the landmark behind
+ * the camera): green shapes, black frames filled with other colours,
+ * posters, marker-like squares. */
+cv::Mat clutterFrame(int k)
+{
+	sim::Scene sc;
+	MapLandmark lm;
+	lm.id = 1;
+	sc.map.landmarks.push_back(lm);
+	sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
+	auto o = nominalRender();
+	o.background = sim::Background::Cluttered;
+	o.distractors = 12;
+	return sim::render(sc, o, 2000 + k).image;
+}
+}  // namespace
+
 TEST(Renders, ClutterWithoutLandmarksGivesNothing)
 {
-	// A landmark behind the camera: only the cluttered wall (green shapes,
-	// black frames filled with other colours, posters, marker-like squares).
 	int found = 0;
 	for (int k = 0; k < 40; ++k)
 	{
-		sim::Scene sc;
-		MapLandmark lm;
-		lm.id = 1;
-		sc.map.landmarks.push_back(lm);
-		sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
-		auto o = nominalRender();
-		o.background = sim::Background::Cluttered;
-		o.distractors = 12;
-		const auto r = sim::render(sc, o, 2000 + k);
-		found += static_cast<int>(run(r.image).landmarks.size());
+		found += static_cast<int>(run(clutterFrame(k)).landmarks.size());
 	}
 	EXPECT_EQ(found, 0);
 }
@@ -610,15 +618,7 @@ TEST(Renders, CentreGateChangesNoDetectionAndRefusesClutter)
 	int linked = 0, fitted_with = 0, fitted_without = 0;
 	for (int k = 0; k < 40; ++k)
 	{
-		sim::Scene sc;
-		MapLandmark lm;
-		lm.id = 1;
-		sc.map.landmarks.push_back(lm);
-		sc.world_T_camera = sim::levelCameraLookingAt(lm, 2.0, 0, 0, M_PI);
-		auto o = nominalRender();
-		o.background = sim::Background::Cluttered;
-		o.distractors = 12;
-		const auto img = sim::render(sc, o, 2000 + k).image;
+		const cv::Mat img = clutterFrame(k);
 		const auto with = detectWithModels(img, cam, g, opt, SubpixelModels());
 		const auto wo = detectWithModels(img, cam, g, opt, without);
 		EXPECT_TRUE(with.landmarks.empty() && wo.landmarks.empty()) << k;

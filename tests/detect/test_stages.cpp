@@ -1263,6 +1263,21 @@ TEST(Code, RejectsGreenCentreOtherFillAndMissingFrame)
 	EXPECT_FALSE(readCode(cut, qc, CameraModel(), g, CodeParams()));
 }
 
+namespace
+{
+/** \a q with each corner moved by a pixel, in direction \a shift (0..15,
+ * sixteenths of a turn), each corner a quarter turn further than the last. */
+Quad movedByAPixel(Quad q, int shift)
+{
+	for (int k = 0; k < 4; ++k)
+	{
+		const double a = M_PI / 8 * shift + k * M_PI / 2;
+		q[k] += Eigen::Vector2d(std::cos(a), std::sin(a));
+	}
+	return q;
+}
+}  // namespace
+
 // The gate before the sub-pixel stage reads the centre cell at corners a
 // pixel off in any direction: a code board passes, a green centre and a
 // green square without a board do not.
@@ -1278,12 +1293,7 @@ TEST(Code, CentreGateToleratesAPixelsCornerErrorAndRefusesAGreenCentre)
 		cv::rectangle(green_centre, cv::Rect(40 + 43, 40 + 43, 15, 15), kGreen, cv::FILLED);
 		for (int shift = 0; shift < 16; ++shift)
 		{
-			Quad q = truth;
-			for (int k = 0; k < 4; ++k)
-			{
-				const double a = M_PI / 8 * shift + k * M_PI / 2;
-				q[k] += Eigen::Vector2d(std::cos(a), std::sin(a));
-			}
+			const Quad q = movedByAPixel(truth, shift);
 			EXPECT_TRUE(centreMayBeBlack(img, q, CameraModel(), g, p)) << id << " " << shift;
 			EXPECT_FALSE(centreMayBeBlack(green_centre, q, CameraModel(), g, p))
 				<< id << " " << shift;
@@ -1299,15 +1309,8 @@ TEST(Code, CentreGateToleratesAPixelsCornerErrorAndRefusesAGreenCentre)
 			Eigen::Vector2d(a, a), Eigen::Vector2d(b, a), Eigen::Vector2d(b, b),
 			Eigen::Vector2d(a, b)};
 		for (int shift = 0; shift < 16; ++shift)
-		{
-			Quad q = corners;
-			for (int k = 0; k < 4; ++k)
-			{
-				const double t = M_PI / 8 * shift + k * M_PI / 2;
-				q[k] += Eigen::Vector2d(std::cos(t), std::sin(t));
-			}
-			EXPECT_TRUE(centreMayBeBlack(small, q, CameraModel(), g, p)) << blur << " " << shift;
-		}
+			EXPECT_TRUE(centreMayBeBlack(small, movedByAPixel(corners, shift), CameraModel(), g, p))
+				<< blur << " " << shift;
 	}
 	// A green square on black: a frame, but no code board.
 	cv::Mat square(180, 180, CV_8UC3, kBlack);
