@@ -340,7 +340,8 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> debug_arg(
 			"", "debug-dir",
 			"Folder (created when missing) that receives per image a sub-folder with the "
-			"detector's stage images: colour mask, components, edgels, fitted lines, overlay.",
+			"detector's stage images: colour mask, components, edgels, fitted lines (in "
+			"magenta the quadrangles refused because their centre cell reads green), overlay.",
 			false, "", "DIR", cmd);
 		TCLAP::SwitchArg colour_arg(
 			"", "colour-report",

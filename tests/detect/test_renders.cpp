@@ -9,11 +9,14 @@
 #include <codemark/sim/povray.h>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -631,6 +634,45 @@ TEST(Renders, CentreGateChangesNoDetectionAndRefusesClutter)
 		fitted_without, fitted_with);
 	ASSERT_GE(fitted_without, 8);
 	EXPECT_LE(fitted_with, fitted_without / 4);
+}
+
+// The debug images show the quadrangles the centre gate refused (in
+// magenta on 4_lines.png), so that a landmark lost there can be seen.
+TEST(Renders, DebugLinesShowTheGatesRefusals)
+{
+	namespace fs = std::filesystem;
+	const fs::path dir =
+		fs::temp_directory_path() / ("codemark_debug_gate_" + std::to_string(getpid()));
+	int frame = -1;
+	for (int k = 0; k < 40 && frame < 0; ++k)
+	{
+		const auto r = run(clutterFrame(k));
+		if (r.counts.quads > r.counts.fitted) frame = k;
+	}
+	ASSERT_GE(frame, 0);
+	const auto magenta = [](const cv::Mat& img)
+	{
+		int n = 0;
+		for (int y = 0; y < img.rows; ++y)
+			for (int x = 0; x < img.cols; ++x)
+			{
+				const auto& p = img.at<cv::Vec3b>(y, x);
+				n += p[0] > 200 && p[2] > 200 && p[1] < 60;
+			}
+		return n;
+	};
+	fs::create_directories(dir);
+	run(clutterFrame(frame), dir.string());
+	const cv::Mat lines = cv::imread((dir / "4_lines.png").string());
+	ASSERT_FALSE(lines.empty());
+	EXPECT_GT(magenta(lines), 20);
+	// A frame with a landmark and no refusal draws none.
+	const Shot s = shoot(42, 2.0, 20 * kDeg, nominalRender(), 4242);
+	fs::remove_all(dir);
+	fs::create_directories(dir);
+	run(s.render.image, dir.string());
+	EXPECT_EQ(magenta(cv::imread((dir / "4_lines.png").string())), 0);
+	fs::remove_all(dir);
 }
 
 TEST(Renders, GreyOnlyImageGivesNothing)

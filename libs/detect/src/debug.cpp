@@ -115,8 +115,12 @@ void writeDebugImages(
 	save(dir, "3_edgels.png", ed);
 
 	// 4: sub-pixel edge points and fitted lines (undistorted coordinates,
-	// drawn as they are: close to raw for mild distortion).
+	// drawn as they are: close to raw for mild distortion); in magenta, the
+	// linked quadrangles refused before the sub-pixel stage.
 	cv::Mat li = greyBackdrop(bgr);
+	for (const auto& q : d.refused)
+		for (int k = 0; k < 4; ++k)
+			cv::line(li, fix(q[k]), fix(q[(k + 1) % 4]), {255, 0, 255}, 1, cv::LINE_AA, kShift);
 	for (const auto& q : d.quads)
 	{
 		for (int k = 0; k < 4; ++k)

@@ -17,6 +17,9 @@ struct DebugRecord
 	std::vector<Candidate> candidates;
 	std::vector<EdgelMap> edgels;  //!< one per examined ROI
 	std::vector<RefinedQuad> quads;	 //!< every refined quadrangle, decoded or not
+	/** The linked quadrangles (raw corners) that the centre gate refused
+	 * (centreMayBeBlack()). */
+	std::vector<Quad> refused;
 };
 
 /** Writes 1_mask.png, 2_components.png, 3_edgels.png, 4_lines.png and

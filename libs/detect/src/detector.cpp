@@ -100,7 +100,11 @@ DetectionResult detectWithModels(
 			for (int k = 0; k < 4; ++k) ideal[k] = camera.undistortPixel((*quad)[k]);
 			const bool pass = centreMayBeBlack(bgr, ideal, camera, geometry, opt.code);
 			tm.code_us += microsSince(t);
-			if (!pass) continue;
+			if (!pass)
+			{
+				if (debug) dbg.refused.push_back(*quad);
+				continue;
+			}
 		}
 
 		// 7. Sub-pixel edges, a line per side, corners.
