@@ -377,23 +377,14 @@ std::vector<Candidate> findCandidates(
 		c.roi =
 			cv::Rect(c.bbox.x - gx, c.bbox.y - gy, c.bbox.width + 2 * gx, c.bbox.height + 2 * gy) &
 			cv::Rect(0, 0, bgr.cols, bgr.rows);
+		// The code's centre cell: a hole in the fill near the box's centre.
+		// It reads the mask only, so it comes before the fill's mean G (a
+		// pass over every cell of the component in the image) and spares it
+		// to the green shapes without one (posters, shapes on a wall).
+		if (!centreEvidence(mask, c, step, centre_cell_rel, p)) continue;
 		out.push_back(c);
 		keep[l] = 1;
 	}
-	// The code's centre cell: a hole in the fill near the box's centre. It
-	// reads the mask only, so it goes first and spares the fill's mean G
-	// (a pass over every cell of the component) to the green shapes without
-	// one (posters, shapes on a wall).
-	out.erase(
-		std::remove_if(
-			out.begin(), out.end(),
-			[&](const Candidate& c)
-			{
-				if (centreEvidence(mask, c, step, centre_cell_rel, p)) return false;
-				keep[c.label - 1] = 0;
-				return true;
-			}),
-		out.end());
 	// Mean G of each survivor's fill (for the gradient threshold).
 	if (!out.empty())
 	{
