@@ -8,8 +8,11 @@
 #    read noise 6 e-), the peer of every other row;
 #  - that sensor with one stage of docs/camera-pipeline.md added (the
 #    webcam's and the phone's settings, each demosaicing algorithm);
-#  - the webcam preset with one stage removed;
-#  - the presets webcam, phone and family whole.
+#  - the webcam preset with one stage removed (the sensor's noise too: what
+#    is left is the processing's own, the same in every frame of a still
+#    camera);
+#  - the presets webcam, phone and family whole, and phone without the
+#    sensor's noise.
 # Every row renders the same poses, prints, lights and noise seeds, so the
 # rows differ by their stages alone. Writes docs/benchmarks/pipeline-stages.md.
 #
@@ -24,7 +27,7 @@ renders=500
 seed=11
 while [[ $# -gt 0 ]]; do
 	case "$1" in
-		-h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+		-h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 		--renders) renders="$2"; shift 2 ;;
 		--seed) seed="$2"; shift 2 ;;
 		*) echo "bench-pipeline-stages.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
@@ -66,7 +69,9 @@ rows=(
 	"webcam-srgb|webcam with linear transfer|preset = webcam;transfer = linear"
 	"webcam-unsharp|webcam without unsharp masking|preset = webcam;unsharp_amount = 0"
 	"webcam-jpeg|webcam without JPEG|preset = webcam;jpeg_quality = 0"
+	"webcam-noise|webcam without the sensor's noise|preset = webcam;full_well_e = 0"
 	"phone|phone (every stage)|preset = phone"
+	"phone-noise|phone without the sensor's noise|preset = phone;full_well_e = 0"
 	"family|family (every stage drawn per frame)|preset = family"
 )
 
