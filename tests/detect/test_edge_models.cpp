@@ -418,3 +418,35 @@ TEST(EdgeModels, EdgeSlopeIsTheMedianResponseSlopeAtTheEdges)
 	EXPECT_DOUBLE_EQ(edgeSlope(side, edges), 7.0);
 	EXPECT_EQ(edgeSlope(side, std::vector<std::optional<double>>(6)), 0.0);
 }
+
+// midmeanOf(): the mean of the middle half. Two equal populations (a
+// noise-free side's alternate rows) give their middle, where the median
+// gives one of them; a quarter of wild values on either side leaves it;
+// up to five values it is the median.
+TEST(EdgeModels, MidmeanLiesBetweenPopulationsAndIgnoresTheWildQuarter)
+{
+	std::vector<double> two;
+	for (int k = 0; k < 20; ++k) two.push_back(k % 2 ? 0.3 : 0.1);
+	std::vector<double> copy = two;
+	EXPECT_NEAR(midmeanOf(two), 0.2, 1e-12);
+	EXPECT_NEAR(std::abs(medianOf(copy) - 0.2), 0.1, 1e-12);
+
+	std::vector<double> wild;
+	for (int k = 0; k < 12; ++k) wild.push_back(0.01 * (k % 3));
+	for (int k = 0; k < 4; ++k) wild.push_back(k % 2 ? 5.0 : -3.0);
+	EXPECT_NEAR(midmeanOf(wild), 0.01, 1e-12);
+
+	for (std::vector<double> x :
+		 {std::vector<double>{7.0},
+		  {1.0, 3.0},
+		  {9.0, 1.0, 2.0},
+		  {9.0, -4.0, 1.0, 2.0},
+		  {9.0, -4.0, 1.0, 2.0, 1.5}})
+	{
+		std::vector<double> y = x;
+		std::sort(y.begin(), y.end());
+		const size_t n = y.size();
+		const double median = n % 2 ? y[n / 2] : 0.5 * (y[n / 2 - 1] + y[n / 2]);
+		EXPECT_DOUBLE_EQ(midmeanOf(x), median) << n << " values";
+	}
+}

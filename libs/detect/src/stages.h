@@ -205,6 +205,14 @@ struct SubpixelModels
 /** The median of \a x (reordered; not empty). */
 double medianOf(std::vector<double>& x);
 
+/** The mean of the middle half of \a x (reordered; not empty): the
+ * interquartile mean. Where a sample falls into populations, as a side's
+ * profiles do under a camera's processing (a Bayer mosaic's rows
+ * alternate, JPEG's blocks repeat every 8 pixels), the median of a
+ * noise-free sample lies on one of them and the midmean between them;
+ * like the median it ignores the wildest quarter either side. */
+double midmeanOf(std::vector<double>& x);
+
 /** A sample's median and its standard error. */
 struct MedianWithError
 {
