@@ -422,7 +422,7 @@ TEST(EdgeModels, EdgeSlopeIsTheMedianResponseSlopeAtTheEdges)
 // midmeanOf(): the mean of the middle half. Two equal populations (a
 // noise-free side's alternate rows) give their middle, where the median
 // gives one of them; a quarter of wild values on either side leaves it;
-// up to five values it is the median.
+// up to six values it is the median.
 TEST(EdgeModels, MidmeanLiesBetweenPopulationsAndIgnoresTheWildQuarter)
 {
 	std::vector<double> two;
@@ -441,7 +441,8 @@ TEST(EdgeModels, MidmeanLiesBetweenPopulationsAndIgnoresTheWildQuarter)
 		  {1.0, 3.0},
 		  {9.0, 1.0, 2.0},
 		  {9.0, -4.0, 1.0, 2.0},
-		  {9.0, -4.0, 1.0, 2.0, 1.5}})
+		  {9.0, -4.0, 1.0, 2.0, 1.5},
+		  {9.0, -4.0, 1.0, 2.0, 1.5, 0.0}})
 	{
 		std::vector<double> y = x;
 		std::sort(y.begin(), y.end());

@@ -30,7 +30,7 @@ double medianOf(std::vector<double>& x)
 
 double midmeanOf(std::vector<double>& x)
 {
-	// A quarter (rounded up) off either end: the median itself up to 5.
+	// A quarter (rounded up) off either end: the median itself up to 6.
 	const size_t n = x.size();
 	size_t lo = (n + 3) / 4, hi = n - lo;
 	if (hi <= lo) lo = (n - 1) / 2, hi = n - lo;
