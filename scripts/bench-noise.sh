@@ -83,16 +83,19 @@ fit_rows=()
 run_set() { # name renderer preset
 	local name="$1" renderer="$2" preset="$3" dir="$WORK/$1"
 	for seed in 1 2; do
-		if [[ ! -f "$dir/run$seed/dataset.rawlog" ]]; then
-			mkdir -p "$dir/run$seed"
+		# Written into a scratch directory renamed once complete: an
+		# interrupted run leaves no dataset that a later run would reuse.
+		if [[ ! -d "$dir/run$seed" ]]; then
+			rm -rf "$dir/run$seed.partial" && mkdir -p "$dir/run$seed.partial"
 			if [[ $renderer == own ]]; then
 				"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" \
-					--preset "$preset" -o "$dir/run$seed" >&2
+					--preset "$preset" -o "$dir/run$seed.partial" >&2
 			else
 				"$bin/codemark-simul/codemark-simul" -q -c "$WORK/povray.ini" -s "$seed" \
 					--preset "$preset" --renderer povray --light normal --wall plaster --floor tiles \
-					-o "$dir/run$seed" >&2
+					-o "$dir/run$seed.partial" >&2
 			fi
+			mv "$dir/run$seed.partial" "$dir/run$seed"
 		fi
 	done
 	local t0=$SECONDS frames
@@ -134,11 +137,13 @@ scaled realistic 3 "$WORK/realistic-large.ini"
 declare -A verdicts ratios
 for seed in $(seq 1 "$SEEDS"); do
 	dir="$WORK/linear/seed$seed"
-	if [[ ! -f "$dir/annotated.rawlog" ]]; then
-		mkdir -p "$dir"
-		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" -o "$dir" >&2
-		"$bin/codemark-annotate/codemark-annotate" -q -i "$dir/dataset.rawlog" \
-			-o "$dir/annotated.rawlog" --map "$dir/map.txt" --calibration realistic --drop-images >&2
+	if [[ ! -d "$dir" ]]; then
+		rm -rf "$dir.partial" && mkdir -p "$dir.partial"
+		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" -o "$dir.partial" >&2
+		"$bin/codemark-annotate/codemark-annotate" -q -i "$dir.partial/dataset.rawlog" \
+			-o "$dir.partial/annotated.rawlog" --map "$dir.partial/map.txt" --calibration realistic \
+			--drop-images >&2
+		mv "$dir.partial" "$dir"
 	fi
 	for cal in own small large; do
 		c=realistic
