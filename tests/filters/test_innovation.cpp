@@ -149,3 +149,39 @@ TEST(Innovation, PersistentErrorsShowAtTheVisits)
 		EXPECT_NEAR(r.visit_ratio / r.other_ratio, visit_scale, 0.5 * visit_scale);
 	}
 }
+
+// A visit whose first sighting lies beyond the gate (an outlier the filters
+// reject) is left out of the comparison: three such sightings in twelve
+// visits, each with a NIS of 60, would flag persistent errors on their own.
+TEST(Innovation, SightingsBeyondTheGateStayOutOfTheVisits)
+{
+	for (const bool gated : {true, false})
+	{
+		std::mt19937 rng(11);
+		std::chi_squared_distribution<double> chi2(3.0);
+		std::vector<std::vector<Innovation>> steps;
+		for (int visit = 0; visit < 12; ++visit)
+		{
+			for (int k = 0; k < 10; ++k)
+			{
+				Innovation in;
+				in.id = visit % 3;
+				in.nis = chi2(rng);
+				if (k == 0 && visit % 4 == 0)
+				{
+					in.nis = 60;
+					in.gated = gated;
+				}
+				steps.push_back({in});
+			}
+			steps.emplace_back();
+		}
+		std::vector<const std::vector<Innovation>*> ptrs;
+		for (const auto& s : steps) ptrs.push_back(&s);
+		const InnovationSummary r = summariseInnovations(ptrs);
+		EXPECT_EQ(r.count, 120);  // the mean NIS keeps every sighting
+		EXPECT_EQ(r.gated, gated ? 3 : 0);
+		EXPECT_EQ(r.visits, gated ? 9 : 12);
+		EXPECT_EQ(r.persistent_errors, !gated) << gated;
+	}
+}

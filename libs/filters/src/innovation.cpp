@@ -73,6 +73,10 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 				if (std::isfinite(in.component_share[i]))
 					c_share[i] += in.component_share[i], ++n_share[i];
 			}
+			// Visits and the others compare the sightings inside the gate: one
+			// beyond it is an outlier the filters reject (counted in gated),
+			// and one such NIS would outweigh a run's visits.
+			if (in.gated) continue;
 			if (!before.count(in.id))
 				++r.visits, visit_nis += in.nis, visit_dof += in.dof;
 			else

@@ -130,9 +130,9 @@ struct InnovationSummary
 	std::array<double, 3> component_nis = Innovation::nanComponents();
 	std::array<double, 3> component_share = Innovation::nanComponents();
 	double neg_log_likelihood = 0;	//!< sum of (log det S + NIS) / 2 (infinite NIS: +inf)
-	long visits = 0;  //!< first sightings of a visit (finite NIS)
+	long visits = 0;  //!< first sightings of a visit (finite NIS, inside the gate)
 	double visit_ratio = 0;	 //!< their mean NIS / DoF
-	double other_ratio = 0;	 //!< the other sightings' mean NIS / DoF
+	double other_ratio = 0;	 //!< the other sightings' (inside the gate) mean NIS / DoF
 	/** The visits' NIS exceed the others' beyond chance (their sum, over
 	 * other_ratio, above chi2inv(0.99) of their degrees of freedom): the
 	 * sightings' errors persist from frame to frame, and the NIS over all
