@@ -56,7 +56,8 @@ inflation() {
   echo "to $seeds: \"default\" is the renderer's own image model in linear light (no preset;"
   echo "annotated and localized with that source's own calibration, \`realistic\`), \"webcam\" and"
   echo "\"phone\" its frames through those presets (the default calibration); every run starts unknown. The particle filter runs with the shipped"
-  echo "\`pf.ini\` and with its likelihood's \`sigma_scale\` and floors set to the neutral values; the"
+  echo "\`pf.ini\` (\`sigma_scale\` 1, floors 1 cm and 0.5 deg), with \`sigma_scale\` 1.5, and with the floors"
+  echo "removed (each \`sigma_scale\`); the"
   echo "EKF (shipped \`ekf.ini\`) on the same runs is the peer. ATE: mean over the seeds of each run's"
   echo "RMS position error; NEES / DoF: median over the seeds of each run's mean (1 when the covariance"
   echo "is honest); NIS / DoF: the range over the seeds, and the runs whose verdict is \`consistent\`"
@@ -113,9 +114,8 @@ inflation() {
   echo
   echo "Without the floors a near sighting's C_L (a bearing known to hundredths of a milliradian) is"
   echo "narrower than the particles' spacing: the cloud collapses onto a few particles and its NEES"
-  echo "leaves every band. \`sigma_scale\` lowers the ATE through the camera pipelines, where a"
-  echo "sighting's error persists from frame to frame. With both, the cloud is wider than the"
-  echo "sightings alone warrant, which the NIS verdict reads as covariances too large."
+  echo "leaves every band. With the floors the cloud is wider than the sightings alone warrant,"
+  echo "which the NIS verdict reads as covariances too large."
 }
 {
   echo "# Particle filter benchmark"
