@@ -119,6 +119,29 @@ TEST(Innovation, SummaryKeepsInfiniteNisOutOfTheMean)
 		EXPECT_NE(json.find(key), std::string::npos) << key;
 }
 
+// Twelve visits of three landmarks, ten steps of one sighting each and a
+// step without sightings after each visit (which ends it), summarised;
+// \a sighting(visit, k) gives the k-th sighting of a visit.
+template <class Sighting>
+InnovationSummary summariseVisits(Sighting sighting)
+{
+	std::vector<std::vector<Innovation>> steps;
+	for (int visit = 0; visit < 12; ++visit)
+	{
+		for (int k = 0; k < 10; ++k)
+		{
+			Innovation in = sighting(visit, k);
+			in.id = visit % 3;
+			steps.push_back({in});
+		}
+		steps.emplace_back();
+	}
+	std::vector<const std::vector<Innovation>*> ptrs;
+	ptrs.reserve(steps.size());
+	for (const auto& s : steps) ptrs.push_back(&s);
+	return summariseInnovations(ptrs);
+}
+
 // Visits: a landmark's first sighting after a step without it. Drawn NIS
 // with the visits' scale 4x the others' flag persistent errors; the same
 // scale does not (at the 1% level, over these seeds' draws).
@@ -128,21 +151,13 @@ TEST(Innovation, PersistentErrorsShowAtTheVisits)
 	std::chi_squared_distribution<double> chi2(3.0);
 	for (const double visit_scale : {1.0, 4.0})
 	{
-		std::vector<std::vector<Innovation>> steps;
-		for (int visit = 0; visit < 12; ++visit)
-		{
-			for (int k = 0; k < 10; ++k)
+		const InnovationSummary r = summariseVisits(
+			[&](int, int k)
 			{
 				Innovation in;
-				in.id = visit % 3;
 				in.nis = (k == 0 ? visit_scale : 1.0) * chi2(rng);
-				steps.push_back({in});
-			}
-			steps.emplace_back();  // a step without sightings ends the visit
-		}
-		std::vector<const std::vector<Innovation>*> ptrs;
-		for (const auto& s : steps) ptrs.push_back(&s);
-		const InnovationSummary r = summariseInnovations(ptrs);
+				return in;
+			});
 		EXPECT_EQ(r.visits, 12);
 		EXPECT_EQ(r.count, 120);
 		EXPECT_EQ(r.persistent_errors, visit_scale > 1) << visit_scale;
@@ -159,26 +174,18 @@ TEST(Innovation, SightingsBeyondTheGateStayOutOfTheVisits)
 	{
 		std::mt19937 rng(11);
 		std::chi_squared_distribution<double> chi2(3.0);
-		std::vector<std::vector<Innovation>> steps;
-		for (int visit = 0; visit < 12; ++visit)
-		{
-			for (int k = 0; k < 10; ++k)
+		const InnovationSummary r = summariseVisits(
+			[&](int visit, int k)
 			{
 				Innovation in;
-				in.id = visit % 3;
 				in.nis = chi2(rng);
 				if (k == 0 && visit % 4 == 0)
 				{
 					in.nis = 60;
 					in.gated = gated;
 				}
-				steps.push_back({in});
-			}
-			steps.emplace_back();
-		}
-		std::vector<const std::vector<Innovation>*> ptrs;
-		for (const auto& s : steps) ptrs.push_back(&s);
-		const InnovationSummary r = summariseInnovations(ptrs);
+				return in;
+			});
 		EXPECT_EQ(r.count, 120);  // the mean NIS keeps every sighting
 		EXPECT_EQ(r.gated, gated ? 3 : 0);
 		EXPECT_EQ(r.visits, gated ? 9 : 12);
