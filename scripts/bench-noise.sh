@@ -78,25 +78,40 @@ f = lambda v: "-" if v is None else "%.2f (%.0f%%)" % (v["nis"], 100 * (v["sight
 print(" / ".join(f(c.get(k)) for k in ("range", "bearing", "orientation")))' "$1"
 }
 
+# Runs COMMAND with a scratch directory as its last argument and renames
+# that to DIR once COMMAND is done, so that an interrupted run leaves no
+# dataset a later run would reuse; nothing to do when DIR exists.
+build_once() { # DIR COMMAND...
+	local dir="$1"
+	shift
+	[[ -d "$dir" ]] && return 0
+	rm -rf "$dir.partial" && mkdir -p "$dir.partial"
+	"$@" "$dir.partial"
+	mv "$dir.partial" "$dir"
+}
+
+simulate() { # renderer preset seed out
+	if [[ $1 == own ]]; then
+		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$3" --preset "$2" -o "$4" >&2
+	else
+		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/povray.ini" -s "$3" --preset "$2" \
+			--renderer povray --light normal --wall plaster --floor tiles -o "$4" >&2
+	fi
+}
+
+# The linear-light loop of one seed, annotated with its source's own calibration.
+simulate_annotated() { # seed out
+	"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$1" -o "$2" >&2
+	"$bin/codemark-annotate/codemark-annotate" -q -i "$2/dataset.rawlog" -o "$2/annotated.rawlog" \
+		--map "$2/map.txt" --calibration realistic --drop-images >&2
+}
+
 rows=()
 fit_rows=()
 run_set() { # name renderer preset
 	local name="$1" renderer="$2" preset="$3" dir="$WORK/$1"
 	for seed in 1 2; do
-		# Written into a scratch directory renamed once complete: an
-		# interrupted run leaves no dataset that a later run would reuse.
-		if [[ ! -d "$dir/run$seed" ]]; then
-			rm -rf "$dir/run$seed.partial" && mkdir -p "$dir/run$seed.partial"
-			if [[ $renderer == own ]]; then
-				"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" \
-					--preset "$preset" -o "$dir/run$seed.partial" >&2
-			else
-				"$bin/codemark-simul/codemark-simul" -q -c "$WORK/povray.ini" -s "$seed" \
-					--preset "$preset" --renderer povray --light normal --wall plaster --floor tiles \
-					-o "$dir/run$seed.partial" >&2
-			fi
-			mv "$dir/run$seed.partial" "$dir/run$seed"
-		fi
+		build_once "$dir/run$seed" simulate "$renderer" "$preset" "$seed"
 	done
 	local t0=$SECONDS frames
 	"$bin/codemark-calibrate-noise/codemark-calibrate-noise" -q -r "$dir/run1/dataset.rawlog" \
@@ -137,14 +152,7 @@ scaled realistic 3 "$WORK/realistic-large.ini"
 declare -A verdicts ratios
 for seed in $(seq 1 "$SEEDS"); do
 	dir="$WORK/linear/seed$seed"
-	if [[ ! -d "$dir" ]]; then
-		rm -rf "$dir.partial" && mkdir -p "$dir.partial"
-		"$bin/codemark-simul/codemark-simul" -q -c "$WORK/own.ini" -s "$seed" -o "$dir.partial" >&2
-		"$bin/codemark-annotate/codemark-annotate" -q -i "$dir.partial/dataset.rawlog" \
-			-o "$dir.partial/annotated.rawlog" --map "$dir.partial/map.txt" --calibration realistic \
-			--drop-images >&2
-		mv "$dir.partial" "$dir"
-	fi
+	build_once "$dir" simulate_annotated "$seed"
 	for cal in own small large; do
 		c=realistic
 		[[ $cal == small ]] && c="$WORK/realistic-small.ini"
