@@ -158,6 +158,15 @@ struct FrameResult
 	double corner_sigma_px = NAN;  // the detector's own corner sigma
 	double noise_grey = NAN;  // the image noise the detector measured
 	double bend_px = NAN, bend_se_px = NAN;	 // the bands' bend and its standard error
+	/** Per side k (corner k to k + 1): the mean of its two corners' errors
+	 * across the true side [px], positive outwards, and their difference
+	 * (the far corner's less the near one's: the side's tilt); whether the
+	 * true side runs more along u than v. */
+	std::array<double, 4> side_offset_px{NAN, NAN, NAN, NAN}, side_tilt_px{NAN, NAN, NAN, NAN};
+	std::array<bool, 4> side_horizontal{};
+	/** The error of the left side's height less the right side's [px]: what
+	 * phi2 reads near face-on. */
+	double height_diff_err_px = NAN;
 };
 
 double wrapPi(double a) { return std::atan2(std::sin(a), std::cos(a)); }
@@ -207,6 +216,22 @@ FrameResult evaluate(
 		sideLengths(c, &w, &h);
 		out.width_err_px = w - w_true;
 		out.height_err_px = h - h_true;
+		const Eigen::Vector2d centre =
+			0.25 * (t.corners_px[0] + t.corners_px[1] + t.corners_px[2] + t.corners_px[3]);
+		for (int k = 0; k < 4; ++k)
+		{
+			const Eigen::Vector2d &a = t.corners_px[k], &b = t.corners_px[(k + 1) % 4];
+			const Eigen::Vector2d dir = (b - a).normalized();
+			Eigen::Vector2d normal(-dir.y(), dir.x());
+			if (normal.dot(0.5 * (a + b) - centre) < 0) normal = -normal;
+			const double ea = normal.dot(c[k] - a), eb = normal.dot(c[(k + 1) % 4] - b);
+			out.side_offset_px[k] = 0.5 * (ea + eb);
+			out.side_tilt_px[k] = eb - ea;
+			out.side_horizontal[k] = std::abs(dir.x()) > std::abs(dir.y());
+		}
+		const auto heightDiff = [](const std::array<Eigen::Vector2d, 4>& q)
+		{ return (q[3] - q[0]).norm() - (q[2] - q[1]).norm(); };
+		out.height_diff_err_px = heightDiff(c) - heightDiff(t.corners_px);
 		const pose::Measurement& me = m.measurement;
 		const Eigen::Vector3d& L = t.sighting.L;
 		out.range_err_rel = (me.L[0] - L[0]) / L[0];
@@ -359,6 +384,46 @@ void writeScatterHalves(std::ostream& os, const std::vector<Run>& runs)
 	os << "\n";
 }
 
+/** The sides' errors split by their direction in the image: an edge error
+ * that depends on where the edge falls in the pixel grid (the mosaic's
+ * period, JPEG's 8-px blocks) is one offset along a side that follows a
+ * row or a column, and turns into a tilt along a side that rises by part
+ * of a period. */
+void writeSideErrors(std::ostream& os, const std::vector<Run>& runs)
+{
+	os << "### Side errors along rows and columns\n\n"
+	   << "The same frames (eligible, detected): each side's error across it from its two "
+		  "corners' errors, as the RMS of their mean (offset, positive outwards) and of their "
+		  "difference (tilt, the far end's less the near one's), for the sides that run more "
+		  "along the image's rows (top and bottom) and along its columns (left and right); and "
+		  "the RMS error of the left side's height less the right side's, which phi2 reads near "
+		  "face-on.\n\n"
+	   << "| source | preset | frames | rows: offset / tilt RMS [px] | columns: offset / tilt "
+		  "RMS [px] | height difference RMS [px] |\n"
+	   << "| --- | --- | --- | --- | --- | --- |\n";
+	for (const auto& run : runs)
+	{
+		std::array<std::vector<double>, 2> offset, tilt;
+		std::vector<double> height_diff;
+		for (const auto& r : run.frames)
+		{
+			if (!r.eligible || !r.detected) continue;
+			height_diff.push_back(r.height_diff_err_px);
+			for (int k = 0; k < 4; ++k)
+			{
+				const int i = r.side_horizontal[k] ? 0 : 1;
+				offset[i].push_back(r.side_offset_px[k]);
+				tilt[i].push_back(r.side_tilt_px[k]);
+			}
+		}
+		os << "| " << run.source << " | " << run.preset << " | " << height_diff.size() << " | "
+		   << fmt(rms(offset[0]), 3) << " / " << fmt(rms(tilt[0]), 3) << " | "
+		   << fmt(rms(offset[1]), 3) << " / " << fmt(rms(tilt[1]), 3) << " | "
+		   << fmt(rms(height_diff), 3) << " |\n";
+	}
+	os << "\n";
+}
+
 void writeReport(
 	std::ostream& os, const std::vector<Run>& runs, const std::string& header,
 	const std::string& camera_desc)
@@ -389,6 +454,7 @@ void writeReport(
 	}
 	os << "\n";
 	writeScatterHalves(os, runs);
+	writeSideErrors(os, runs);
 	for (const auto& run : runs)
 	{
 		os << "## " << run.source << ", preset " << run.preset << "\n\n"
