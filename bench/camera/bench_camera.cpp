@@ -384,11 +384,12 @@ void writeScatterHalves(std::ostream& os, const std::vector<Run>& runs)
 	os << "\n";
 }
 
-/** The sides' errors split by their direction in the image: an edge error
- * that depends on where the edge falls in the pixel grid (the mosaic's
- * period, JPEG's 8-px blocks) is one offset along a side that follows a
- * row or a column, and turns into a tilt along a side that rises by part
- * of a period. */
+/** The sides' errors split by their direction in the image. Near face-on
+ * phi2 reads the difference of the left and right sides' heights, that
+ * is the top and bottom sides' tilts; an edge error that depends on where
+ * the edge falls in the pixel grid (the mosaic's period, JPEG's 8-px
+ * blocks) is one offset along a side that follows a column exactly, and
+ * a tilt along one that rises by part of a period. */
 void writeSideErrors(std::ostream& os, const std::vector<Run>& runs)
 {
 	os << "### Side errors along rows and columns\n\n"
