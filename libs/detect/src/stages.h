@@ -192,6 +192,8 @@ struct SubpixelModels
 	bool thin_frame = true;
 	/** Stage 7b: centreOnBand(). */
 	bool band_midline = true;
+	/** Stage 7c: fitFramePerspective(). */
+	bool frame_perspective = true;
 	/** The Peak locator's step model (EdgeMode::Peak rather than
 	 * EdgeMode::PeakGaussian). */
 	bool step_peak = true;
@@ -586,6 +588,22 @@ bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
 void centreOnBand(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, double fill_ratio, const SubpixelParams& p);
+
+/** Stage 7c: the square's perspective from the frame's inner and outer
+ * edges. The outer edge (black against the sheet, frame_ratio of the side
+ * outside the inner one) is located on profiles along rows or columns
+ * from the frame outwards (luma; clear of the outer corners by a frame's
+ * width), each outer side's points fitted by fitLine() and kept where
+ * they lie within 1.5 px of the edge the square predicts. One homography
+ * is then fitted to the inner sides' lines (their points moved onto the
+ * lines \a q holds) and the outer sides' directions (their offsets are
+ * free: the outer edge's response shift, the margin and dot gain move
+ * them), each side weighted by its points' scatter about its own line; \a
+ * q's sides and corners follow unless a corner would move by more than
+ * 1 px. Nothing changes where no outer side is read. */
+void fitFramePerspective(
+	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
+	double frame_ratio, const SubpixelParams& p);
 
 // ------------------------------------------------------------------ stage 8
 /** The code of one landmark. */
