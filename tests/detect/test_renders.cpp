@@ -53,13 +53,14 @@ std::string label(const char* name, double v, uint64_t seed)
 	s << name << "=" << v << " seed=" << seed;
 	return s.str();
 }
-/** The sub-pixel stage's models with the green band's midline off: the
- * clip's tests below are of the single-edge models, in linear light, where
- * they are exact. */
+/** The sub-pixel stage's models with the green band's midline and the
+ * frame's perspective off: the clip's tests below are of the single-edge
+ * models, in linear light, where they are exact. */
 SubpixelModels singleEdgeModels()
 {
 	SubpixelModels m;
 	m.band_midline = false;
+	m.frame_perspective = false;
 	return m;
 }
 

@@ -183,6 +183,8 @@ void fitFramePerspective(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& cam, double min_rise, double frame_ratio,
 	const SubpixelParams& p)
 {
+	if (std::any_of(q.levels_rounded.begin(), q.levels_rounded.end(), [](bool r) { return r; }))
+		return;
 	const Eigen::Matrix3d H0 = faceToImage(q.corners_ideal);
 	const FaceMap map{H0, cam, cam.hasDistortion()};
 	// The data: per inner side its points moved onto its line (the bands'
