@@ -167,14 +167,17 @@ std::vector<Eigen::Vector2d> outerEdgePoints(
 	return pts;
 }
 
-/** The unit-normal line (a, c) of the face line through \a f0 and \a f1
- * under the face-to-ideal homography \a H. */
-Eigen::Vector3d imageLine(
-	const Eigen::Matrix3d& H, const Eigen::Vector2d& f0, const Eigen::Vector2d& f1)
+/** The face line through \a f0 and \a f1 (homogeneous). */
+Eigen::Vector3d faceLine(const Eigen::Vector2d& f0, const Eigen::Vector2d& f1)
 {
-	const Eigen::Vector3d l_face =
-		Eigen::Vector3d(f0.x(), f0.y(), 1).cross(Eigen::Vector3d(f1.x(), f1.y(), 1));
-	const Eigen::Vector3d l = H.inverse().transpose() * l_face;
+	return Eigen::Vector3d(f0.x(), f0.y(), 1).cross(Eigen::Vector3d(f1.x(), f1.y(), 1));
+}
+
+/** The image line of the face line \a l_face under the line map \a G (the
+ * face-to-image homography's inverse transpose), scaled to a unit normal. */
+Eigen::Vector3d imageLine(const Eigen::Matrix3d& G, const Eigen::Vector3d& l_face)
+{
+	const Eigen::Vector3d l = G * l_face;
 	return l / l.head<2>().norm();
 }
 }  // namespace
@@ -183,15 +186,26 @@ void fitFramePerspective(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& cam, double min_rise, double frame_ratio,
 	const SubpixelParams& p)
 {
-	if (std::any_of(q.levels_rounded.begin(), q.levels_rounded.end(), [](bool r) { return r; }))
+	if (!q.bands_bent ||
+		std::any_of(q.levels_rounded.begin(), q.levels_rounded.end(), [](bool r) { return r; }))
 		return;
 	const Eigen::Matrix3d H0 = faceToImage(q.corners_ideal);
 	const FaceMap map{H0, cam, cam.hasDistortion()};
+	// Lines map through the homography's inverse transpose: the fit works
+	// on that map directly, so that no evaluation inverts a matrix.
+	const Eigen::Matrix3d G0 = H0.inverse().transpose();
+	const double scale = 1 + 2 * frame_ratio;
+	std::array<Eigen::Vector3d, 4> face_inner, face_outer;
+	for (int side = 0; side < 4; ++side)
+	{
+		const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
+		face_inner[side] = faceLine(f0, f1);
+		face_outer[side] = faceLine(f0 * scale, f1 * scale);
+	}
 	// The data: per inner side its points moved onto its line (the bands'
 	// centring moved the line, not the points); per outer side its inliers.
 	std::array<std::optional<SideMoments>, 4> inner, outer;
 	int outer_sides = 0;
-	const double scale = 1 + 2 * frame_ratio;
 	for (int side = 0; side < 4; ++side)
 	{
 		const LineFit& l = q.sides[side];
@@ -206,8 +220,7 @@ void fitFramePerspective(
 		opts = inliers(opts, *f, p);
 		if (static_cast<int>(opts.size()) < p.min_support) continue;
 		// Where the predicted outer edge lies.
-		const Eigen::Vector3d pred =
-			imageLine(H0, kFaceCorners[side] * scale, kFaceCorners[(side + 1) % 4] * scale);
+		const Eigen::Vector3d pred = imageLine(G0, face_outer[side]);
 		double offset = 0;
 		for (const auto& x : opts) offset += pred.head<2>().dot(x) + pred[2];
 		if (std::abs(offset / static_cast<double>(opts.size())) > kMaxOffsetPx) continue;
@@ -216,56 +229,62 @@ void fitFramePerspective(
 	}
 	if (outer_sides == 0) return;
 
-	// Levenberg-Marquardt on H's eight free entries (H(2, 2) held), from
-	// the inner square's H0; three residuals per inner side (its offset and
-	// its scatter's two axes), two per outer side (its direction only).
-	const double h22 = H0(2, 2);
-	const auto residuals = [&](const Eigen::Matrix<double, 8, 1>& h)
+	// Levenberg-Marquardt on the line map's eight free entries (G(2, 2)
+	// held), from the inner square's; three residuals per inner side (its
+	// offset and its scatter's two axes), two per outer side (its
+	// direction only).
+	const double g22 = G0(2, 2);
+	using Vec8 = Eigen::Matrix<double, 8, 1>;
+	using Res = Eigen::Matrix<double, 20, 1>;
+	const auto mapOf = [&](const Vec8& g)
 	{
-		Eigen::Matrix3d H;
-		H << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h22;
-		Eigen::Matrix<double, 20, 1> r = Eigen::Matrix<double, 20, 1>::Zero();
+		Eigen::Matrix3d G;
+		G << g[0], g[1], g[2], g[3], g[4], g[5], g[6], g[7], g22;
+		return G;
+	};
+	const auto residuals = [&](const Vec8& g)
+	{
+		const Eigen::Matrix3d G = mapOf(g);
+		Res r = Res::Zero();
 		int i = 0;
 		for (int side = 0; side < 4; ++side)
 		{
-			const Eigen::Vector2d &f0 = kFaceCorners[side], &f1 = kFaceCorners[(side + 1) % 4];
 			const SideMoments& m = *inner[side];
-			const Eigen::Vector3d l = imageLine(H, f0, f1);
+			const Eigen::Vector3d l = imageLine(G, face_inner[side]);
 			const double w = 1 / std::sqrt(m.scatter2);
 			r[i++] = w * std::sqrt(m.n) * (l.head<2>().dot(m.mean) + l[2]);
 			for (const auto& e : m.axes) r[i++] = w * l.head<2>().dot(e);
 			if (!outer[side]) continue;
 			const SideMoments& o = *outer[side];
-			const Eigen::Vector3d lo = imageLine(H, f0 * scale, f1 * scale);
+			const Eigen::Vector3d lo = imageLine(G, face_outer[side]);
 			const double wo = 1 / std::sqrt(o.scatter2);
 			for (const auto& e : o.axes) r[i++] = wo * lo.head<2>().dot(e);
 		}
 		return r;
 	};
-	Eigen::Matrix<double, 8, 1> h;
-	h << H0(0, 0), H0(0, 1), H0(0, 2), H0(1, 0), H0(1, 1), H0(1, 2), H0(2, 0), H0(2, 1);
-	Eigen::Matrix<double, 20, 1> r = residuals(h);
+	Vec8 g;
+	g << G0(0, 0), G0(0, 1), G0(0, 2), G0(1, 0), G0(1, 1), G0(1, 2), G0(2, 0), G0(2, 1);
+	Res r = residuals(g);
 	double cost = r.squaredNorm(), mu = 1e-3;
-	for (int it = 0; it < 20; ++it)
+	for (int it = 0; it < 10; ++it)
 	{
 		Eigen::Matrix<double, 20, 8> J;
 		for (int k = 0; k < 8; ++k)
 		{
-			Eigen::Matrix<double, 8, 1> hk = h;
-			const double step = 1e-6 * std::max(1.0, std::abs(h[k]));
-			hk[k] += step;
-			J.col(k) = (residuals(hk) - r) / step;
+			Vec8 gk = g;
+			const double step = 1e-7 * std::max(1e-3, std::abs(g[k]));
+			gk[k] += step;
+			J.col(k) = (residuals(gk) - r) / step;
 		}
 		Eigen::Matrix<double, 8, 8> A = J.transpose() * J;
 		A.diagonal() += mu * A.diagonal().cwiseMax(1e-12);
-		const Eigen::Matrix<double, 8, 1> dh = -A.ldlt().solve(J.transpose() * r);
-		if (!dh.allFinite()) return;
-		const Eigen::Matrix<double, 8, 1> hc = h + dh;
-		const Eigen::Matrix<double, 20, 1> rc = residuals(hc);
+		const Vec8 dg = -A.ldlt().solve(J.transpose() * r);
+		if (!dg.allFinite()) return;
+		const Res rc = residuals(g + dg);
 		if (rc.squaredNorm() < cost)
 		{
-			const bool done = cost - rc.squaredNorm() < 1e-10 * cost;
-			h = hc;
+			const bool done = cost - rc.squaredNorm() < 1e-8 * cost;
+			g += dg;
 			r = rc;
 			cost = rc.squaredNorm();
 			mu = std::max(1e-9, mu * 0.3);
@@ -274,12 +293,11 @@ void fitFramePerspective(
 		else if ((mu *= 10) > 1e6)
 			break;
 	}
-	Eigen::Matrix3d H;
-	H << h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], h22;
+	const Eigen::Matrix3d G = mapOf(g);
 	RefinedQuad next = q;
 	for (int side = 0; side < 4; ++side)
 	{
-		const Eigen::Vector3d l = imageLine(H, kFaceCorners[side], kFaceCorners[(side + 1) % 4]);
+		const Eigen::Vector3d l = imageLine(G, face_inner[side]);
 		LineFit& s = next.sides[side];
 		const double sign = l.head<2>().dot(s.normal) < 0 ? -1 : 1;
 		s.normal = sign * l.head<2>();

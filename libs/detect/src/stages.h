@@ -552,6 +552,9 @@ struct RefinedQuad
 	/** The bands' bend (DetectionQuality::edge_bend_px) and its standard
 	 * error [px]; 0 when not measured. */
 	double bend_px = 0, bend_se_px = 0;
+	/** Stage 7b found the bands wider or narrower than printed and moved
+	 * the sides (bandsShowBend()): a camera's response and processing. */
+	bool bands_bent = false;
 	/** Per side: its edges corrected for the rounding of their levels
 	 * (correctLevelRounding(): a noise-free, sharp side, then exact). */
 	std::array<bool, 4> levels_rounded{{false, false, false, false}};
@@ -603,10 +606,14 @@ void centreOnBand(
  * free: the outer edge's response shift, the margin and dot gain move
  * them), each side weighted by its points' scatter about its own line; \a
  * q's sides and corners follow unless a corner would move by more than
- * 1 px. Nothing changes where no outer side is read, nor where an inner
- * side's levels were corrected for their rounding
- * (RefinedQuad::levels_rounded: a noise-free, sharp image, whose inner
- * edges are then exact and whose outer edge is not). */
+ * 1 px. Only where stage 7b found the bands bent (RefinedQuad::bands_bent:
+ * a camera's response and processing, which tilt the inner edges too); in
+ * linear light the inner edges stand, as they do for the bands, and the
+ * outer edge, whose bright side is the sheet's narrow margin, would add
+ * its own errors. Nor where an inner side's levels were corrected for
+ * their rounding (RefinedQuad::levels_rounded: a noise-free, sharp image,
+ * whose inner edges are then exact and whose outer edge is not). Nothing
+ * changes where no outer side is read. */
 void fitFramePerspective(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, const SubpixelParams& p);
