@@ -53,14 +53,13 @@ std::string label(const char* name, double v, uint64_t seed)
 	s << name << "=" << v << " seed=" << seed;
 	return s.str();
 }
-/** The sub-pixel stage's models with the green band's midline and the
- * frame's perspective off: the clip's tests below are of the single-edge
- * models, in linear light, where they are exact. */
+/** The sub-pixel stage's models with the green band's midline off: the
+ * clip's tests below are of the single-edge models, in linear light, where
+ * they are exact. */
 SubpixelModels singleEdgeModels()
 {
 	SubpixelModels m;
 	m.band_midline = false;
-	m.frame_perspective = false;
 	return m;
 }
 
@@ -946,78 +945,5 @@ TEST(Renders, BandMidlineOnCommittedPovrayFrames)
 			EXPECT_LT(std::abs(with), 0.05);
 			EXPECT_LT(std::abs(with), 0.3 * without);
 		}
-	}
-}
-
-// Stage 7c: near face-on phi2 reads the left and right sides' heights,
-// whose difference the top and bottom lines' tilt sets. Through a camera's
-// processing the inner edges alone tilt by about a tenth of a pixel; the
-// frame's outer edge reads the perspective a second time at other phases
-// of the pixel grid, and the fit to both errs by much less.
-TEST(Renders, FramePerspectiveReadsTheHeightDifference)
-{
-	const CameraModel cam;
-	const LandmarkGeometry g;
-	const DetectorOptions opt;
-	SubpixelModels inner_only;
-	inner_only.frame_perspective = false;
-	const auto heightDiff = [](const std::array<Eigen::Vector2d, 4>& c)
-	{ return (c[3] - c[0]).norm() - (c[2] - c[1]).norm(); };
-	for (const char* preset : {"webcam", "phone"})
-	{
-		auto o = nominalRender();
-		o.applyPreset(preset);
-		double sq_with = 0, sq_without = 0;
-		int n = 0;
-		for (int k = 0; k < 24; ++k)
-		{
-			const double dist = 2.0 + 0.1 * k, angle = (k % 7 - 3) * 10.0;
-			const Shot s = shoot(
-				(k * 37 + 5) % 256, dist, angle * kDeg, o, 5200 + k, 0.08 * (k % 5 - 2),
-				0.2 * (k % 3 - 1));
-			const auto& t = s.render.truth[0];
-			const auto with = detectWithModels(s.render.image, cam, g, opt, SubpixelModels());
-			const auto wo = detectWithModels(s.render.image, cam, g, opt, inner_only);
-			SCOPED_TRACE(std::string(preset) + " view " + std::to_string(k));
-			ASSERT_EQ(with.landmarks.size(), 1u);
-			ASSERT_EQ(wo.landmarks.size(), 1u);
-			const double truth = heightDiff(t.corners_px);
-			sq_with += std::pow(heightDiff(with.landmarks[0].detection.corners) - truth, 2);
-			sq_without += std::pow(heightDiff(wo.landmarks[0].detection.corners) - truth, 2);
-			++n;
-		}
-		const double rms_with = std::sqrt(sq_with / n), rms_without = std::sqrt(sq_without / n);
-		std::printf(
-			"[ perspective ] %s: height difference error RMS %.3f px, inner edges alone %.3f px\n",
-			preset, rms_with, rms_without);
-		EXPECT_LT(rms_with, 0.8 * rms_without) << preset;
-	}
-}
-
-// A sheet cut at the frame (no white margin: the frame's outer edge meets a
-// wall as dark as itself) has no outer edge to read: the square stays as
-// the inner edges put it.
-TEST(Renders, FramePerspectiveLeavesASquareWithoutOuterEdge)
-{
-	const CameraModel cam;
-	const LandmarkGeometry g;
-	const DetectorOptions opt;
-	SubpixelModels inner_only;
-	inner_only.frame_perspective = false;
-	auto o = nominalRender();
-	o.background = sim::Background::Flat;
-	o.background_grey = 25;
-	o.white_bgr = o.black_bgr;
-	for (int k = 0; k < 6; ++k)
-	{
-		const Shot s =
-			shoot((k * 53 + 9) % 256, 1.0 + 0.5 * k, (k % 3 - 1) * 25 * kDeg, o, 5300 + k);
-		const auto with = detectWithModels(s.render.image, cam, g, opt, SubpixelModels());
-		const auto wo = detectWithModels(s.render.image, cam, g, opt, inner_only);
-		SCOPED_TRACE("view " + std::to_string(k));
-		ASSERT_EQ(with.landmarks.size(), 1u);
-		ASSERT_EQ(wo.landmarks.size(), 1u);
-		for (int c = 0; c < 4; ++c)
-			EXPECT_EQ(with.landmarks[0].detection.corners[c], wo.landmarks[0].detection.corners[c]);
 	}
 }

@@ -320,10 +320,7 @@ void centreOnBand(
 	// inner edge outwards by about a fifth of the error. Each pass from the
 	// previous one's square leaves a fifth of it: three leave under 1%.
 	for (int pass = 0; pass < 3; ++pass)
-	{
 		if (!centreOnBandOnce(bgr, q, cam, min_rise, frame_ratio, fill_ratio, p, pass == 0)) return;
-		q.bands_bent = true;
-	}
 }
 
 }  // namespace codemark::detect

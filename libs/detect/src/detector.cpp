@@ -114,8 +114,6 @@ DetectionResult detectWithModels(
 		if (!refined) continue;
 		if (models.band_midline)
 			centreOnBand(bgr, *refined, camera, thr, frame_ratio, fill_ratio, opt.subpixel);
-		if (models.frame_perspective)
-			fitFramePerspective(bgr, *refined, camera, thr, frame_ratio, opt.subpixel);
 		tm.subpixel_us += microsSince(t);
 		++res.counts.fitted;
 

@@ -192,8 +192,6 @@ struct SubpixelModels
 	bool thin_frame = true;
 	/** Stage 7b: centreOnBand(). */
 	bool band_midline = true;
-	/** Stage 7c: fitFramePerspective(). */
-	bool frame_perspective = true;
 	/** The Peak locator's step model (EdgeMode::Peak rather than
 	 * EdgeMode::PeakGaussian). */
 	bool step_peak = true;
@@ -552,12 +550,6 @@ struct RefinedQuad
 	/** The bands' bend (DetectionQuality::edge_bend_px) and its standard
 	 * error [px]; 0 when not measured. */
 	double bend_px = 0, bend_se_px = 0;
-	/** Stage 7b found the bands wider or narrower than printed and moved
-	 * the sides (bandsShowBend()): a camera's response and processing. */
-	bool bands_bent = false;
-	/** Per side: its edges corrected for the rounding of their levels
-	 * (correctLevelRounding(): a noise-free, sharp side, then exact). */
-	std::array<bool, 4> levels_rounded{{false, false, false, false}};
 };
 
 /** Edge profiles along each side of \a coarse (one per row or column), the
@@ -594,29 +586,6 @@ bool cornersFromSides(RefinedQuad& q, const CameraModel& camera);
 void centreOnBand(
 	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
 	double frame_ratio, double fill_ratio, const SubpixelParams& p);
-
-/** Stage 7c: the square's perspective from the frame's inner and outer
- * edges. The outer edge (black against the sheet, frame_ratio of the side
- * outside the inner one) is located on profiles along rows or columns
- * from the frame outwards (luma; clear of the outer corners by a frame's
- * width), each outer side's points fitted by fitLine() and kept where
- * they lie within 1.5 px of the edge the square predicts. One homography
- * is then fitted to the inner sides' lines (their points moved onto the
- * lines \a q holds) and the outer sides' directions (their offsets are
- * free: the outer edge's response shift, the margin and dot gain move
- * them), each side weighted by its points' scatter about its own line; \a
- * q's sides and corners follow unless a corner would move by more than
- * 1 px. Only where stage 7b found the bands bent (RefinedQuad::bands_bent:
- * a camera's response and processing, which tilt the inner edges too); in
- * linear light the inner edges stand, as they do for the bands, and the
- * outer edge, whose bright side is the sheet's narrow margin, would add
- * its own errors. Nor where an inner side's levels were corrected for
- * their rounding (RefinedQuad::levels_rounded: a noise-free, sharp image,
- * whose inner edges are then exact and whose outer edge is not). Nothing
- * changes where no outer side is read. */
-void fitFramePerspective(
-	const cv::Mat& bgr, RefinedQuad& q, const CameraModel& camera, double min_rise,
-	double frame_ratio, const SubpixelParams& p);
 
 // ------------------------------------------------------------------ stage 8
 /** The code of one landmark. */

@@ -761,7 +761,6 @@ std::optional<RefinedQuad> refineQuadrangle(
 		const bool rounded =
 			models.level_rounding && !clips && !all_clipped &&
 			correctLevelRounding(prof.g, n, prof.pos, prof.origin, prof.half, prof.inward, edges);
-		out.levels_rounded[side] = rounded;
 		out.channel[side] = EdgeChannel::Green;
 		if (!rounded && !clips && choice.channel == EdgeChannel::Luma)
 		{
