@@ -22,6 +22,12 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <regex>
+#include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace codemark;
@@ -228,4 +234,43 @@ TEST(CalibrateNoise, FitFromWrongModelsRestoresTheFilter)
 			EXPECT_LT(std::abs(std::log(ra[i] / rb[i])), 3 * fits[0].relative_std[i])
 				<< "seed " << seed << " scale " << i;
 	}
+}
+
+// The bearing's innovation is nearly all the odometry's prediction on these
+// loops (the image pins phi1 far tighter), so its NIS tests the motion
+// noise the fit holds fixed: codemark-calibrate-noise warns when a config
+// adds far more motion noise per step than the fine odometry has, and not
+// when the config adds none.
+TEST(CalibrateNoise, WarnsOfAMotionNoiseThePredictionsComponentContradicts)
+{
+	const Loop& l = loop(1);
+	std::ifstream in(std::string(CODEMARK_SOURCE_SHARE_DIR) + "/config/ekf.ini");
+	const std::string shipped{std::istreambuf_iterator<char>(in), {}};
+	auto motionWarnings = [&](const std::string& var)
+	{
+		const std::regex key(R"(\n(extra_motion_var_(xy_m2|yaw_rad2)) *= *[^\n]*)");
+		EXPECT_TRUE(std::regex_search(shipped, key)) << "the shipped ekf.ini sets the key";
+		const auto path = l.dir / ("ekf_motion_" + var + ".ini");
+		std::ofstream(path) << std::regex_replace(shipped, key, "\n$1 = " + var);
+		NoiseFitRequest req;
+		req.rawlog = l.rawlog;
+		req.map_file = l.map;
+		req.config_file = path.string();
+		req.calibration = pose::shippedCalibrationPath("realistic");
+		const NoiseFitResult r = fitSightingNoise(req);
+		std::vector<std::string> found;
+		for (const auto& w : r.warnings)
+			if (w.find("motion noise") != std::string::npos) found.push_back(w);
+		std::cout << "extra motion variance " << var << ": bearing NIS " << r.after.component_nis[1]
+				  << " (sightings' share " << r.after.component_share[1] << "), " << found.size()
+				  << " warning(s)\n";
+		for (const auto& w : found) std::cout << "  " << w << "\n";
+		return found;
+	};
+	const auto none = motionWarnings("0");
+	const auto large = motionWarnings("1e-4");
+	EXPECT_TRUE(none.empty());
+	ASSERT_EQ(large.size(), 1u);
+	EXPECT_NE(large[0].find("bearing"), std::string::npos) << large[0];
+	EXPECT_NE(large[0].find("too large"), std::string::npos) << large[0];
 }

@@ -13,7 +13,8 @@
  * (a least-squares fit of its table with exponent 1, its table's
  * correlation for both parts). The motion noise stays the config's: with
  * it held fixed, the innovations' spread beyond the prediction's is the
- * sightings' own.
+ * sightings' own. The components the sightings barely inform (the bearing)
+ * test that motion noise, and a warning says when they contradict it.
  */
 #include <codemark/filters/localizer.h>
 #include <codemark/pose/measurement.h>
