@@ -168,6 +168,14 @@ int main(int argc, char** argv)
 					  << req.rawlog << " --map " << (req.map_file.empty() ? "MAP" : req.map_file)
 					  << " --out calibration.ini, then codemark-localize --calibration "
 						 "calibration.ini";
+		// The components the sightings barely inform judge the prediction.
+		if (!s.prediction.verdict.empty() && s.prediction.verdict != "consistent")
+			std::cout << "; the " << s.prediction.components
+					  << " innovations are the prediction's and read NIS/DoF " << s.prediction.ratio
+					  << ": its covariance looks " << s.prediction.verdict
+					  << " (the odometry's model in the rawlog, the config's motion noise"
+					  << (s.method == "pf" ? ", the likelihood's floors and roughening" : "")
+					  << ")";
 		std::cout << "\n";
 		return 0;
 	}

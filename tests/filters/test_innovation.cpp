@@ -2,6 +2,8 @@
 #include <codemark/eval/localization.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <random>
@@ -94,6 +96,56 @@ TEST(Innovation, VerdictBandAndWording)
 	EXPECT_EQ(nisVerdict(24.0, 3.0, 10), "covariances too small by about 8x");
 	EXPECT_EQ(nisVerdict(0.75, 3.0, 10), "covariances too large by about 4x");
 	EXPECT_EQ(nisVerdict(0.0, 0.0, 0), "no sightings tested");
+}
+
+// A component the sightings barely inform (here the bearing: its
+// measurement variance 1e-4 of the prediction's) reads the prediction's
+// scale whatever the sightings' covariance; the others are not counted.
+TEST(Innovation, PredictionCheckReadsTheComponentsTheSightingsBarelyInform)
+{
+	std::mt19937 rng(7);
+	std::normal_distribution<double> g;
+	const Eigen::Vector3d P(1e-6, 1e-4, 1e-6), R(1e-4, 1e-8, 1e-4);
+	for (const double q : {1.0, 1.0 / 9.0, 9.0})
+	{
+		LocalizeSummary s;
+		s.method = "ekf";
+		for (int i = 0; i < 2000; ++i)
+		{
+			PathRow r;
+			// The prediction's true spread is q times the one the filter has.
+			const Eigen::Vector3d sd = (q * P + R).cwiseSqrt();
+			const Eigen::Vector3d nu(sd[0] * g(rng), sd[1] * g(rng), sd[2] * g(rng));
+			const Eigen::MatrixXd Rm = R.asDiagonal().toDenseMatrix();
+			r.stats.innovations.push_back(
+				makeInnovation(nu, Eigen::Matrix3d((P + R).asDiagonal()), 1e9, &Rm));
+			s.rows.push_back(r);
+		}
+		summariseInnovations(s);
+		EXPECT_EQ(s.prediction.components, "bearing");
+		EXPECT_NEAR(s.prediction.ratio, q, 0.1 * q) << q;
+		if (q == 1.0)
+			EXPECT_EQ(s.prediction.verdict, "consistent");
+		else if (q > 1)
+			EXPECT_EQ(s.prediction.verdict.rfind("too small by about ", 0), 0u)
+				<< s.prediction.verdict;
+		else
+			EXPECT_EQ(s.prediction.verdict.rfind("too large by about ", 0), 0u)
+				<< s.prediction.verdict;
+		const auto j = nlohmann::json::parse(summaryJson(s));
+		EXPECT_EQ(j.at("prediction_check").at("components"), "bearing");
+		EXPECT_EQ(j.at("prediction_check").at("verdict"), s.prediction.verdict);
+	}
+	// Without a component under the share, or without shares: no check.
+	InnovationSummary n;
+	n.component_nis = {1.0, 0.2, 1.0};
+	n.component_share = {0.5, 0.2, 0.9};
+	EXPECT_TRUE(predictionCheck(n, kInnovationComponents).verdict.empty());
+	n.component_share = Innovation::nanComponents();
+	EXPECT_TRUE(predictionCheck(n, kInnovationComponents).verdict.empty());
+	LocalizeSummary none;
+	none.method = "ekf";
+	EXPECT_TRUE(nlohmann::json::parse(summaryJson(none)).at("prediction_check").is_null());
 }
 
 // Infinite NIS count as gated and stay out of the mean.

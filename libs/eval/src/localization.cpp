@@ -420,6 +420,7 @@ void summariseInnovations(LocalizeSummary& s)
 	s.nis_visits = n.visits;
 	s.nis_visit_ratio = n.visit_ratio;
 	s.persistent_errors = n.persistent_errors;
+	s.prediction = filters::predictionCheck(n, innovationComponentNames(s.method));
 }
 
 std::string summaryJson(const LocalizeSummary& s)
@@ -465,6 +466,15 @@ std::string summaryJson(const LocalizeSummary& s)
 	j["nis_visits"] = s.nis_visits;
 	j["nis_visit_ratio"] = num(s.nis_visit_ratio, 4);
 	j["persistent_errors"] = s.persistent_errors;
+	// The components the sightings barely inform test the prediction (the
+	// motion noise), not the sightings.
+	if (s.prediction.verdict.empty())
+		j["prediction_check"] = nullptr;
+	else
+		j["prediction_check"] = {
+			{"components", s.prediction.components},
+			{"nis_per_dof", num(s.prediction.ratio, 4)},
+			{"verdict", s.prediction.verdict}};
 	if (s.metrics)
 	{
 		const auto& m = *s.metrics;

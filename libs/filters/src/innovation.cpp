@@ -116,6 +116,33 @@ std::string nisVerdict(double nis_mean, double nis_dof, long count)
 	return o.str();
 }
 
+PredictionCheck predictionCheck(const InnovationSummary& s, const std::array<const char*, 3>& names)
+{
+	PredictionCheck c;
+	double sum = 0;
+	int n = 0;
+	for (size_t i = 0; i < 3; ++i)
+	{
+		const double k = s.component_nis[i], share = s.component_share[i];
+		if (!std::isfinite(k) || !(share < kPredictionComponentShare)) continue;
+		c.components += std::string(n ? " and " : "") + names[i];
+		sum += k;
+		++n;
+	}
+	if (n == 0) return c;
+	c.ratio = sum / n;
+	std::ostringstream o;
+	o << std::setprecision(2);
+	if (c.ratio >= kNisConsistentLow && c.ratio <= kNisConsistentHigh)
+		o << "consistent";
+	else if (c.ratio > kNisConsistentHigh)
+		o << "too small by about " << c.ratio << "x";
+	else
+		o << "too large by about " << (c.ratio > 0 ? 1.0 / c.ratio : 1e9) << "x";
+	c.verdict = o.str();
+	return c;
+}
+
 bool converged(const Eigen::Matrix3d& cov, double std_xy_m, double std_yaw_rad)
 {
 	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov.topLeftCorner<2, 2>());

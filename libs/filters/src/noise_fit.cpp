@@ -27,9 +27,6 @@ constexpr double kShapePriorFactor = 2.0;
 /** Below this mean share of the sightings in the innovations' covariance
  * (Innovation::sighting_share) the run cannot tell their noise. */
 constexpr double kMinSightingShare = 0.25;
-/** A component whose innovation's variance is the sightings' for less than
- * this share is the prediction's: its NIS tests the motion noise. */
-constexpr double kPredictionComponentShare = 0.1;
 
 // The least-squares fit a^2 + b^2 (ref / w)^2 of a sigma table (exponent
 // 1), a^2 and b^2 kept >= 0.
@@ -393,32 +390,19 @@ NoiseFitResult fitSightingNoise(
 			 "help)";
 		r.warnings.push_back(w.str());
 	}
-	// The components the sightings barely inform (the bearing: the image
-	// pins phi1 far tighter than the odometry does) test the motion noise,
-	// which this fit holds fixed: their NIS reads the same whatever C_P.
-	std::string predicted;
-	double k = 0;
-	int n = 0;
-	for (size_t i = 0; i < 3; ++i)
-	{
-		const double c = r.after.component_nis[i], share = r.after.component_share[i];
-		if (!std::isfinite(c) || !(share < kPredictionComponentShare)) continue;
-		predicted += std::string(predicted.empty() ? "" : " and ") + kInnovationComponents[i];
-		k += c;
-		++n;
-	}
-	if (n > 0) k /= n;
-	if (n > 0 && k > 0 && (k < kNisConsistentLow || k > kNisConsistentHigh))
+	// The components the sightings barely inform (the bearing) test the
+	// motion noise, which this fit holds fixed: their NIS reads the same
+	// whatever C_P.
+	const PredictionCheck pc = predictionCheck(r.after, kInnovationComponents);
+	if (!pc.verdict.empty() && pc.verdict != "consistent")
 	{
 		std::ostringstream w;
-		w << std::setprecision(2) << "the " << predicted
+		w << std::setprecision(2) << "the " << pc.components
 		  << " innovations are the odometry's prediction (the sightings under "
 		  << std::lround(100 * kPredictionComponentShare)
-		  << "% of their variance) and read NIS/DoF " << k
-		  << ": the motion noise, held fixed here, looks too "
-		  << (k < kNisConsistentLow ? "large" : "small") << " by about "
-		  << (k < kNisConsistentLow ? 1 / k : k)
-		  << "x (the odometry's model in the rawlog, the config's [ekf] extra_motion_var_*)";
+		  << "% of their variance) and read NIS/DoF " << pc.ratio
+		  << ": the motion noise, held fixed here, looks " << pc.verdict
+		  << " (the odometry's model in the rawlog, the config's [ekf] extra_motion_var_*)";
 		r.warnings.push_back(w.str());
 	}
 	if (r.after.persistent_errors)

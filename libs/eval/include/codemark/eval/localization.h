@@ -139,6 +139,9 @@ struct LocalizeSummary
 	long nis_visits = 0;
 	double nis_visit_ratio = 0;
 	bool persistent_errors = false;
+	/** The prediction as the components the sightings barely inform read it
+	 * (filters::predictionCheck()). */
+	filters::PredictionCheck prediction;
 	long first_fix_step = -1;  //!< first step with an estimate (-1: never)
 	double first_fix_time_s = 0;  //!< time of the first fix after the first step [s]
 	double time_per_step_ms = 0;  //!< mean wall time of filters::Localizer::step() [ms]

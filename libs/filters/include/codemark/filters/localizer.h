@@ -204,6 +204,29 @@ constexpr double kNisConsistentLow = 0.5, kNisConsistentHigh = 2.0;
  * when \a count is 0. */
 std::string nisVerdict(double nis_mean, double nis_dof, long count);
 
+/** Below this share of the sightings in a component's innovation variance
+ * (InnovationSummary::component_share) the component is the prediction's:
+ * its NIS tests the motion noise (and, in the particle filter, whatever
+ * else widens the cloud), whatever the sightings' covariance. */
+constexpr double kPredictionComponentShare = 0.1;
+
+/** The check of the prediction by the components the sightings barely
+ * inform (the bearing: the image pins phi1 far tighter than an odometry). */
+struct PredictionCheck
+{
+	std::string components;	 //!< their names joined by " and " (empty: none)
+	double ratio = std::numeric_limits<double>::quiet_NaN();  //!< their mean NIS / DoF
+	/** "consistent" when ratio lies in [kNisConsistentLow,
+	 * kNisConsistentHigh], else "too large by about Kx" or "too small by
+	 * about Kx" (the prediction's covariance); empty without components. */
+	std::string verdict;
+};
+
+/** The check of \a s by its components under kPredictionComponentShare,
+ * named by \a names (innovationComponentNames()). */
+PredictionCheck predictionCheck(
+	const InnovationSummary& s, const std::array<const char*, 3>& names);
+
 /** Whether a pose covariance \a cov of (x, y, yaw) is a fix: the largest
  * position standard deviation (the x-y block's largest eigenvalue) below
  * \a std_xy_m and the yaw's below \a std_yaw_rad. */
