@@ -102,18 +102,29 @@ InnovationSummary summariseInnovations(const std::vector<const std::vector<Innov
 	return r;
 }
 
-std::string nisVerdict(double nis_mean, double nis_dof, long count)
+namespace
 {
-	if (count <= 0 || !(nis_dof > 0)) return "no sightings tested";
-	const double k = nis_mean / nis_dof;
+// "consistent" when \a k lies in the band, else how far off a covariance
+// is: "too small by about Kx" (k > the band) or "too large by about (1/k)x",
+// with 2 significant digits.
+std::string bandVerdict(double k)
+{
 	if (k >= kNisConsistentLow && k <= kNisConsistentHigh) return "consistent";
 	std::ostringstream o;
 	o << std::setprecision(2);
 	if (k > kNisConsistentHigh)
-		o << "covariances too small by about " << k << "x";
+		o << "too small by about " << k << "x";
 	else
-		o << "covariances too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
+		o << "too large by about " << (k > 0 ? 1.0 / k : 1e9) << "x";
 	return o.str();
+}
+}  // namespace
+
+std::string nisVerdict(double nis_mean, double nis_dof, long count)
+{
+	if (count <= 0 || !(nis_dof > 0)) return "no sightings tested";
+	const std::string v = bandVerdict(nis_mean / nis_dof);
+	return v == "consistent" ? v : "covariances " + v;
 }
 
 PredictionCheck predictionCheck(const InnovationSummary& s, const std::array<const char*, 3>& names)
@@ -131,15 +142,7 @@ PredictionCheck predictionCheck(const InnovationSummary& s, const std::array<con
 	}
 	if (n == 0) return c;
 	c.ratio = sum / n;
-	std::ostringstream o;
-	o << std::setprecision(2);
-	if (c.ratio >= kNisConsistentLow && c.ratio <= kNisConsistentHigh)
-		o << "consistent";
-	else if (c.ratio > kNisConsistentHigh)
-		o << "too small by about " << c.ratio << "x";
-	else
-		o << "too large by about " << (c.ratio > 0 ? 1.0 / c.ratio : 1e9) << "x";
-	c.verdict = o.str();
+	c.verdict = bandVerdict(c.ratio);
 	return c;
 }
 
