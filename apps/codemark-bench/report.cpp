@@ -61,7 +61,7 @@ std::string csvHeader()
 		   "nees_mean,nees_low_95,nees_high_95,nees_inside,first_fix_step,first_fix_s,sightings_"
 		   "used,"
 		   "sightings_rejected,filter_ms_per_step,wall_s,error,nis_mean,nis_dof,nis_count,gated_"
-		   "fraction,nis_verdict";
+		   "fraction,nis_verdict,prediction_nis_per_dof,prediction_verdict";
 }
 
 std::string csvRow(const JobResult& r)
@@ -84,7 +84,9 @@ std::string csvRow(const JobResult& r)
 	  << (s.first_fix_step >= 0 ? fmt(s.first_fix_time_s, 2) : "") << ',' << s.sightings_used << ','
 	  << s.sightings_rejected << ',' << fmt(s.time_per_step_ms, 4) << ',' << fmt(r.wall_s, 2) << ','
 	  << clean(r.error) << ',' << fmt(s.nis_mean, 4) << ',' << fmt(s.nis_dof, 3) << ','
-	  << s.nis_count << ',' << fmt(s.gated_fraction, 4) << ',' << clean(s.nis_verdict);
+	  << s.nis_count << ',' << fmt(s.gated_fraction, 4) << ',' << clean(s.nis_verdict) << ','
+	  << (s.prediction.verdict.empty() ? "" : fmt(s.prediction.ratio, 4)) << ','
+	  << clean(s.prediction.verdict);
 	return o.str();
 }
 
@@ -461,6 +463,10 @@ std::string markdownReport(
 		o << " | " << (s.first_fix_step >= 0 ? fmt(s.first_fix_time_s, 1) : "never") << " | "
 		  << fmt(s.time_per_step_ms, 3) << " | " << fmt(r.wall_s, 1) << " | "
 		  << (s.nis_count ? fmt(s.nis_mean / s.nis_dof, 2) + ": " : std::string()) << s.nis_verdict
+		  << (!s.prediction.verdict.empty() && s.prediction.verdict != "consistent"
+				  ? "; the prediction (" + s.prediction.components + ") " +
+						fmt(s.prediction.ratio, 2) + ": " + s.prediction.verdict
+				  : std::string())
 		  << " |\n";
 	}
 
@@ -503,6 +509,10 @@ std::string markdownReport(
 		 "core of a loaded "
 		 "machine (jobs run in parallel). **wall**: the job's total, including reading, detection "
 		 "and outputs.\n"
+		 "- **NIS/DoF: verdict**: summary.json's mean NIS over its degrees of freedom and "
+		 "`nis_verdict`; then, when it reads outside [0.5, 2], `prediction_check`: the "
+		 "components the sightings barely inform (the bearing), which judge the filter's "
+		 "prediction (its motion noise), not the sightings.\n"
 		 "- Each job's spec section 6 outputs (estimated_path.txt, covariances.txt, summary.json, "
 		 "trajectory.png, "
 		 "...) are in `<dataset>/<method>/`.\n";

@@ -45,7 +45,8 @@ want = ["dataset", "method", "status", "steps", "frames_in_view", "detection_rat
         "max_error_m", "rpe_trans_m", "rpe_yaw_deg", "yaw_rmse_deg", "nees_mean", "nees_low_95",
         "nees_high_95", "nees_inside", "first_fix_step", "first_fix_s", "sightings_used",
         "sightings_rejected", "filter_ms_per_step", "wall_s", "error", "nis_mean", "nis_dof",
-        "nis_count", "gated_fraction", "nis_verdict"]
+        "nis_count", "gated_fraction", "nis_verdict", "prediction_nis_per_dof",
+        "prediction_verdict"]
 with open(sys.argv[1]) as f:
     header = f.readline().strip().split(",")
 assert header == want, f"columns {header}"
@@ -75,6 +76,13 @@ for r in rows:
     assert v["nees_mean"] > 0 and r["nees_inside"] in ("yes", "no")
     assert (r["nees_inside"] == "yes") == (v["nees_low_95"] <= v["nees_mean"] <= v["nees_high_95"])
     assert 0 <= v["first_fix_s"] < 5, f"{name}: first fix {v['first_fix_s']}"
+    # The prediction's check: empty, or a ratio with its verdict.
+    if r["prediction_verdict"]:
+        assert float(r["prediction_nis_per_dof"]) > 0, f"{name}: prediction NIS"
+        assert r["prediction_verdict"] == "consistent" or r["prediction_verdict"].startswith(
+            ("too large by about ", "too small by about ")), f"{name}: {r['prediction_verdict']}"
+    else:
+        assert r["prediction_nis_per_dof"] == "", f"{name}: a ratio without a verdict"
     if r["dataset"] == "images":
         assert float(r["detect_ms_per_frame"]) > 0, f"{name}: no detection time"
     else:
