@@ -463,10 +463,9 @@ std::string markdownReport(
 		o << " | " << (s.first_fix_step >= 0 ? fmt(s.first_fix_time_s, 1) : "never") << " | "
 		  << fmt(s.time_per_step_ms, 3) << " | " << fmt(r.wall_s, 1) << " | "
 		  << (s.nis_count ? fmt(s.nis_mean / s.nis_dof, 2) + ": " : std::string()) << s.nis_verdict
-		  << (!s.prediction.verdict.empty() && s.prediction.verdict != "consistent"
-				  ? "; the prediction (" + s.prediction.components + ") " +
-						fmt(s.prediction.ratio, 2) + ": " + s.prediction.verdict
-				  : std::string())
+		  << (s.prediction.off() ? "; the prediction (" + s.prediction.components + ") " +
+									   fmt(s.prediction.ratio, 2) + ": " + s.prediction.verdict
+								 : std::string())
 		  << " |\n";
 	}
 

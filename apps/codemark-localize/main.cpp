@@ -169,7 +169,7 @@ int main(int argc, char** argv)
 					  << " --out calibration.ini, then codemark-localize --calibration "
 						 "calibration.ini";
 		// The components the sightings barely inform judge the prediction.
-		if (!s.prediction.verdict.empty() && s.prediction.verdict != "consistent")
+		if (s.prediction.off())
 			std::cout << "; the " << s.prediction.components
 					  << " innovations are the prediction's and read NIS/DoF " << s.prediction.ratio
 					  << ": its covariance looks " << s.prediction.verdict

@@ -132,6 +132,7 @@ TEST(Innovation, PredictionCheckReadsTheComponentsTheSightingsBarelyInform)
 		else
 			EXPECT_EQ(s.prediction.verdict.rfind("too large by about ", 0), 0u)
 				<< s.prediction.verdict;
+		EXPECT_EQ(s.prediction.off(), q != 1.0) << q;
 		const auto j = nlohmann::json::parse(summaryJson(s));
 		EXPECT_EQ(j.at("prediction_check").at("components"), "bearing");
 		EXPECT_EQ(j.at("prediction_check").at("verdict"), s.prediction.verdict);
@@ -143,6 +144,7 @@ TEST(Innovation, PredictionCheckReadsTheComponentsTheSightingsBarelyInform)
 	EXPECT_TRUE(predictionCheck(n, kInnovationComponents).verdict.empty());
 	n.component_share = Innovation::nanComponents();
 	EXPECT_TRUE(predictionCheck(n, kInnovationComponents).verdict.empty());
+	EXPECT_FALSE(predictionCheck(n, kInnovationComponents).off());
 	LocalizeSummary none;
 	none.method = "ekf";
 	EXPECT_TRUE(nlohmann::json::parse(summaryJson(none)).at("prediction_check").is_null());

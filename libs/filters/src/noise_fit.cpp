@@ -394,7 +394,7 @@ NoiseFitResult fitSightingNoise(
 	// motion noise, which this fit holds fixed: their NIS reads the same
 	// whatever C_P.
 	const PredictionCheck pc = predictionCheck(r.after, kInnovationComponents);
-	if (!pc.verdict.empty() && pc.verdict != "consistent")
+	if (pc.off())
 	{
 		std::ostringstream w;
 		w << std::setprecision(2) << "the " << pc.components

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -220,6 +221,12 @@ struct PredictionCheck
 	 * kNisConsistentHigh], else "too large by about Kx" or "too small by
 	 * about Kx" (the prediction's covariance); empty without components. */
 	std::string verdict;
+	/** Whether the components read outside the band (a verdict other than
+	 * "consistent"). */
+	bool off() const
+	{
+		return std::isfinite(ratio) && (ratio < kNisConsistentLow || ratio > kNisConsistentHigh);
+	}
 };
 
 /** The check of \a s by its components under kPredictionComponentShare,
